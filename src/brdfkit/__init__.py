@@ -1,0 +1,62 @@
+"""
+brdfkit — physically plausible reflectance models
+==================================================
+
+Evaluate analytic BRDFs, measure their albedo, certify whether they are
+physically plausible, pump up their albedo, fit them to measured materials
+and show them.
+
+Conventions (stated once, here)
+-------------------------------
+- **Frame.** Local shading frame with the surface normal ``n = +z``.
+- **Directions** are unit vectors in float64 arrays of shape ``(..., 3)``.
+  Both point *away* from the surface: ``wi`` toward the light (Lewis's S,
+  Neumann's L, Nielsen's ω_i) and ``wo`` toward the viewer (V, ω_o).
+- **BRDF.** ``model.eval(wi, wo)`` returns f_r in 1/sr **without** the cosine
+  factor (pbrt's choice). Mitsuba's ``BSDF.eval`` includes cos θ_o; where the
+  two meet (tests, benchmarks, rendering) the conversion is written out.
+- **Below the horizon** (cos θ_i ≤ 0 or cos θ_o ≤ 0) the BRDF is 0, never NaN.
+- **Colour.** Reflectance parameters may be given per channel (RGB or a
+  spectrum); they broadcast against a trailing channel axis, and a coloured
+  model returns ``(..., C)``. A model with only scalar parameters returns
+  ``(...)``.
+- **Angles** are radians in the API; the command line takes degrees and says
+  so.
+- **Albedo** a(ω_i) = ∫ f_r(ω_i, ω_o) cos θ_o dω_o (Lewis's k_ρ, Neumann's a).
+- **Randomness.** Monte-Carlo code takes an explicit seed or
+  :class:`numpy.random.Generator`; samplers take the uniform numbers ``u``.
+
+Public objects
+--------------
+- :func:`brdfkit.model` — build a registered model by name (the dispatcher).
+- :data:`brdfkit.MODELS` — the registry: canonical name → model class.
+- :func:`brdfkit.model_names` — the canonical names.
+- :mod:`brdfkit.geometry`, :mod:`brdfkit.fresnel`, :mod:`brdfkit.halfangle`
+  — the shared parts the models are built from.
+
+References
+----------
+- [Lewis1993] R. R. Lewis, *Making Shaders More Physically Plausible*, 1993.
+- [Neumann1999] L. Neumann, A. Neumann, L. Szirmay-Kalos, *Reflectance Models
+  by Pumping up the Albedo Function*, 1999.
+- [Nielsen2015] J. B. Nielsen, J. R. Frisvad, K. Conradsen, H. Aanæs,
+  *Addressing Grazing Angle Reflections in Phong Models*.
+- [Walter2007] B. Walter, S. R. Marschner, H. Li, K. E. Torrance,
+  *Microfacet Models for Refraction through Rough Surfaces*, EGSR 2007.
+"""
+
+from brdfkit.errors import BrdfkitError, ParameterError, UnknownModelError
+from brdfkit.models import MODELS, BRDF, Param, model, model_names
+
+__all__ = [
+    "BRDF",
+    "MODELS",
+    "BrdfkitError",
+    "Param",
+    "ParameterError",
+    "UnknownModelError",
+    "model",
+    "model_names",
+]
+
+__version__ = "0.1.0"

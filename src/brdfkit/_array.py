@@ -1,0 +1,57 @@
+"""Tiny helpers that fix the array-shape convention once.
+
+Directions are float64 arrays of shape ``(..., 3)``; the helpers here validate
+them at the public boundary and give names to the components so that the
+formulas elsewhere read like the papers.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from brdfkit.errors import BrdfkitError
+
+
+def as_directions(v, name: str) -> np.ndarray:
+    """Return *v* as a float64 array of shape ``(..., 3)``; never mutates *v*.
+
+    Raises
+    ------
+    BrdfkitError
+        If the last axis is not of length 3 or a component is not finite.
+    """
+    a = np.asarray(v, dtype=np.float64)
+    if a.ndim == 0 or a.shape[-1] != 3:
+        raise BrdfkitError(
+            f"{name} must be an array of unit vectors of shape (..., 3); got shape {a.shape}"
+        )
+    if not np.all(np.isfinite(a)):
+        raise BrdfkitError(f"{name} contains NaN or infinite components")
+    return a
+
+
+def as_uniform(u, name: str = "u", dim: int = 2) -> np.ndarray:
+    """Return *u* as float64 of shape ``(..., dim)`` with entries in [0, 1]."""
+    a = np.asarray(u, dtype=np.float64)
+    if a.ndim == 0 or a.shape[-1] != dim:
+        raise BrdfkitError(f"{name} must have shape (..., {dim}); got shape {a.shape}")
+    if np.any(~(a >= 0.0) | ~(a <= 1.0)):
+        bad = a[~((a >= 0.0) & (a <= 1.0))].flat[0]
+        raise BrdfkitError(f"{name} must lie in [0, 1]; got {bad!r}")
+    return a
+
+
+def xyz(v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The three components of direction array *v* (views, not copies)."""
+    return v[..., 0], v[..., 1], v[..., 2]
+
+
+def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Dot product over the last axis, broadcasting the leading axes."""
+    return np.einsum("...k,...k->...", a, b) if a.shape == b.shape else np.sum(a * b, axis=-1)
+
+
+def stack(x, y, z) -> np.ndarray:
+    """Stack three broadcastable component arrays into ``(..., 3)``."""
+    x, y, z = np.broadcast_arrays(x, y, z)
+    return np.stack([x, y, z], axis=-1)

@@ -1,0 +1,416 @@
+"""
+The model interface and its compiled evaluation driver
+======================================================
+
+Every reflectance model is a small object built from three pieces:
+
+1. **Parameters** (:class:`Param`), declared once on the class with default,
+   bounds, units and a description. The command line, the fitter and the
+   explorer all read this declaration; there is no second list.
+2. **A scalar kernel** ``kernel(ix, iy, iz, ox, oy, oz, p) -> float``: a
+   Numba ``@njit`` function of the components of wi and wo (local frame,
+   n = +z) and of ``p``, one channel's packed parameters (float64 1-D array).
+   The kernel is where the paper's formula is written — once, over dot
+   products, readable like the paper. It returns 0 below the horizon and a
+   finite value at θ = 90°.
+3. **Sampling** (:meth:`BRDF.sample`, :meth:`BRDF.pdf`), in NumPy. The base
+   class provides the cosine-weighted fallback.
+
+:meth:`BRDF.eval` validates the directions, broadcasts them, and runs the
+kernel over all pairs and channels with :func:`eval_pairs`, a parallel
+compiled loop (Numba ``prange`` over the 2 cores). The NumPy path would reach
+~24 M evaluations/s for modified Phong; this one reaches ~100 M/s, which is
+what lets brdfkit beat Mitsuba 3 end to end (see ``benchmarks/``).
+
+Public objects
+--------------
+- :class:`Param` — a declared parameter.
+- :class:`BRDF` — the base class of all models.
+- :func:`eval_pairs` — the compiled driver (for code that has packed arrays).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numba
+import numpy as np
+
+from brdfkit._array import as_directions, as_uniform
+from brdfkit.errors import ParameterError
+from brdfkit.geometry import pdf_cosine_hemisphere, sample_cosine_hemisphere
+
+__all__ = ["Param", "BRDF", "eval_pairs"]
+
+
+@dataclass(frozen=True)
+class Param:
+    """A model parameter, declared once.
+
+    Attributes
+    ----------
+    name : str
+        The paper's symbol in ASCII (``rho_d``, ``k_s``, ``n``, ``m`` ...).
+    default : float or str
+        Default value (a string for a choice parameter).
+    lower, upper : float
+        Bounds; ``lower_open`` / ``upper_open`` make them strict.
+    unit : str
+        Unit ("1/sr", "rad", "" for dimensionless).
+    doc : str
+        One line: what it means and guidance on values.
+    kind : {"scalar", "colour", "lobes", "choice"}
+        ``colour``: may be given per channel (a 1-D sequence, RGB or a
+        spectrum), broadcasting to a trailing channel axis of the output.
+        ``lobes``: may be a 1-D sequence, one value per lobe.
+        ``choice``: one of ``choices``.
+    choices : tuple of str
+        The allowed values of a choice parameter.
+    optional : bool
+        ``None`` is allowed and means "not given" (e.g. no index of refraction
+        means F = 1). Packed for the kernel as 0.0, which kernels test for.
+    """
+
+    name: str
+    default: float | str
+    lower: float = -math.inf
+    upper: float = math.inf
+    unit: str = ""
+    doc: str = ""
+    kind: str = "scalar"
+    choices: tuple[str, ...] = ()
+    lower_open: bool = False
+    upper_open: bool = False
+    optional: bool = False
+
+    def bounds_text(self) -> str:
+        """The allowed range as text, e.g. ``[0, 1]`` or ``(0, inf)``."""
+        if self.kind == "choice":
+            return "one of " + ", ".join(self.choices)
+        lo = "(" if self.lower_open else "["
+        hi = ")" if self.upper_open or math.isinf(self.upper) else "]"
+        if math.isinf(self.lower):
+            lo = "("
+        return f"{lo}{_fmt(self.lower)}, {_fmt(self.upper)}{hi}"
+
+    def validate(self, value, model: str):
+        """Return *value* converted (float, float array, str or None); raise if invalid."""
+        if value is None and self.optional:
+            return None
+        if self.kind == "choice":
+            if not isinstance(value, str) or value.lower() not in self.choices:
+                raise ParameterError(
+                    f"{model}: parameter {self.name!r} must be {self.bounds_text()}; got {value!r}"
+                )
+            return value.lower()
+        try:
+            arr = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ParameterError(
+                f"{model}: parameter {self.name!r} must be a number in {self.bounds_text()}; "
+                f"got {value!r}"
+            ) from None
+        if arr.ndim > 1 or (arr.ndim == 1 and self.kind == "scalar"):
+            allowed = "a number" if self.kind == "scalar" else "a number or a 1-D sequence"
+            raise ParameterError(
+                f"{model}: parameter {self.name!r} must be {allowed}; got shape {arr.shape}"
+            )
+        if arr.ndim == 1 and arr.size == 0:
+            raise ParameterError(f"{model}: parameter {self.name!r} is an empty sequence")
+        for x in np.atleast_1d(arr):
+            if not self._inside(float(x)):
+                raise ParameterError(
+                    f"{model}: parameter {self.name!r} must lie in {self.bounds_text()}"
+                    f"{' ' + self.unit if self.unit else ''}; got {_fmt(float(x))}"
+                )
+        return float(arr) if arr.ndim == 0 else arr.copy()
+
+    def _inside(self, x: float) -> bool:
+        if not math.isfinite(x):
+            return False
+        lo_ok = x > self.lower if self.lower_open else x >= self.lower
+        hi_ok = x < self.upper if self.upper_open else x <= self.upper
+        return lo_ok and hi_ok
+
+    def to_dict(self) -> dict:
+        """JSON-ready description (used by ``brdfkit models --json``)."""
+        d = {"name": self.name, "default": self.default, "kind": self.kind,
+             "unit": self.unit, "doc": self.doc, "optional": self.optional}
+        if self.kind == "choice":
+            d["choices"] = list(self.choices)
+        else:
+            d["lower"] = None if math.isinf(self.lower) else self.lower
+            d["upper"] = None if math.isinf(self.upper) else self.upper
+            d["bounds"] = self.bounds_text()
+        return d
+
+
+def _fmt(x: float) -> str:
+    if math.isinf(x):
+        return "inf" if x > 0 else "-inf"
+    return f"{x:g}"
+
+
+@numba.njit(parallel=True, cache=True)
+def eval_pairs(kernel, wi, wo, P, out):  # pragma: no cover - compiled
+    """out[j, c] = kernel(wi[j], wo[j], P[c]) for all pairs j and channels c.
+
+    ``wi``, ``wo``: (N, 3) C-contiguous float64; ``P``: (C, K) packed
+    parameters; ``out``: (N, C).
+    """
+    n = wi.shape[0]
+    n_channels = P.shape[0]
+    for j in numba.prange(n):
+        for c in range(n_channels):
+            out[j, c] = kernel(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2], P[c])
+
+
+class BRDF:
+    """Base class of every reflectance model.
+
+    Subclasses set the class attributes below, write ``kernel`` and, where a
+    good sampler exists, override :meth:`sample` and :meth:`pdf`.
+
+    Class attributes
+    ----------------
+    name : str
+        Canonical registry name (``modified-phong``).
+    aliases : tuple of str
+        Other accepted names.
+    params : tuple of Param
+        The declared parameters.
+    citation : str
+        Paper and equation number.
+    reciprocal : bool
+        Whether the formula is symmetric in (wi, wo) for all parameters.
+    has_sampler : bool
+        True when :meth:`sample` follows the lobe (not the cosine fallback).
+    width_param : str or None
+        The parameter that a half-angle ``beta`` (radians) converts to.
+    """
+
+    name: ClassVar[str] = ""
+    aliases: ClassVar[tuple[str, ...]] = ()
+    params: ClassVar[tuple[Param, ...]] = ()
+    citation: ClassVar[str] = ""
+    summary: ClassVar[str] = ""
+    reciprocal: ClassVar[bool] = True
+    has_sampler: ClassVar[bool] = False
+    width_param: ClassVar[str | None] = None
+    kernel: Callable
+
+    # ------------------------------------------------------------------ set-up
+    def __init__(self, **values):
+        declared = {p.name: p for p in self.params}
+        beta = values.pop("beta", None)
+        unknown = sorted(set(values) - set(declared))
+        if unknown:
+            raise ParameterError(
+                f"{self.name}: unknown parameter {unknown[0]!r}; valid parameters: "
+                + ", ".join(declared) + (", beta" if self.width_param else "")
+            )
+        if beta is not None:
+            if self.width_param is None:
+                raise ParameterError(
+                    f"{self.name}: has no lobe width, so 'beta' is not a parameter; valid "
+                    "parameters: " + ", ".join(declared)
+                )
+            if self.width_param in values:
+                raise ParameterError(
+                    f"{self.name}: give either 'beta' or {self.width_param!r}, not both"
+                )
+            values[self.width_param] = self.width_from_beta(_check_beta(self.name, beta))
+        self._values: dict = {}
+        for p in self.params:
+            v = values.get(p.name, p.default)
+            self._values[p.name] = p.validate(v, self.name)
+        self._check_lobes()
+        self.n_channels = self._count_channels()
+        self._validate()
+        self._packed = self._pack()
+
+    @classmethod
+    def width_from_beta(cls, beta: float) -> float:
+        """Width parameter for half-angle *beta* (radians); see :mod:`brdfkit.halfangle`."""
+        raise NotImplementedError
+
+    def _validate(self) -> None:
+        """Cross-parameter checks of a subclass (raise :class:`ParameterError`)."""
+
+    def _check_lobes(self) -> None:
+        sizes = {p.name: np.size(self._values[p.name]) for p in self.params
+                 if p.kind == "lobes" and np.ndim(self._values[p.name]) == 1}
+        if len(set(sizes.values())) > 1:
+            raise ParameterError(
+                f"{self.name}: per-lobe parameters must have the same length; got "
+                + ", ".join(f"{k}={v}" for k, v in sizes.items())
+            )
+
+    def _count_channels(self) -> int | None:
+        sizes = {p.name: np.size(self._values[p.name]) for p in self.params
+                 if p.kind == "colour" and np.ndim(self._values[p.name]) == 1}
+        if not sizes:
+            return None
+        if len(set(sizes.values())) > 1:
+            raise ParameterError(
+                f"{self.name}: per-channel parameters must have the same number of channels; "
+                "got " + ", ".join(f"{k}={v}" for k, v in sizes.items())
+            )
+        return next(iter(sizes.values()))
+
+    def n_lobes(self) -> int:
+        """Number of lobes given by ``lobes`` parameters (1 when all are scalar)."""
+        sizes = [np.size(self._values[p.name]) for p in self.params if p.kind == "lobes"]
+        return max(sizes, default=1)
+
+    def channel_values(self, c: int) -> dict:
+        """Parameter values of channel *c* (colour parameters indexed, others as given)."""
+        out = {}
+        for p in self.params:
+            v = self._values[p.name]
+            if v is None:
+                v = None
+            elif p.kind == "colour" and np.ndim(v) == 1:
+                v = float(v[c])
+            elif p.kind == "lobes":
+                v = np.broadcast_to(np.atleast_1d(v), (self.n_lobes(),)).astype(np.float64)
+            out[p.name] = v
+        return out
+
+    def _pack_channel(self, v: dict) -> list[float]:
+        """One channel's kernel argument ``p``; default: declared order, choices as index."""
+        row = []
+        for p in self.params:
+            if v[p.name] is None:
+                row.append(0.0)  # "not given": kernels test for 0 (see Param.optional)
+            elif p.kind == "choice":
+                row.append(float(p.choices.index(v[p.name])))
+            elif p.kind == "lobes":
+                row.extend(np.asarray(v[p.name], dtype=np.float64).tolist())
+            else:
+                row.append(float(v[p.name]))
+        return row
+
+    def _pack(self) -> np.ndarray:
+        rows = [self._pack_channel(self.channel_values(c)) for c in range(self.n_channels or 1)]
+        return np.ascontiguousarray(np.array(rows, dtype=np.float64))
+
+    # --------------------------------------------------------------- accessors
+    @property
+    def values(self) -> dict:
+        """The parameter values (a copy; arrays for per-channel values)."""
+        return {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in self._values.items()}
+
+    @property
+    def packed(self) -> np.ndarray:
+        """Packed kernel parameters, shape (C, K) — read-only view."""
+        view = self._packed.view()
+        view.flags.writeable = False
+        return view
+
+    def with_params(self, **changes) -> BRDF:
+        """A new model of the same kind with some parameters changed."""
+        merged = self.values
+        if "beta" in changes and self.width_param:
+            merged.pop(self.width_param, None)
+        merged.update(changes)
+        return type(self)(**merged)
+
+    def to_dict(self) -> dict:
+        """``{"model": name, "params": {...}}`` with lists for per-channel values."""
+        return {
+            "model": self.name,
+            "params": {k: (v.tolist() if isinstance(v, np.ndarray) else v)
+                       for k, v in self._values.items()},
+        }
+
+    def __repr__(self) -> str:
+        args = ", ".join(f"{k}={(v.tolist() if isinstance(v, np.ndarray) else v)!r}"
+                         for k, v in self._values.items())
+        return f"brdfkit.model({self.name!r}, {args})"
+
+    # -------------------------------------------------------------- evaluation
+    def eval(self, wi, wo) -> np.ndarray:
+        """BRDF value f_r(wi, wo) in 1/sr, without the cosine factor.
+
+        Parameters
+        ----------
+        wi, wo : array_like, shape (..., 3)
+            Unit directions toward the light and the viewer (local frame,
+            normal +z). Leading axes broadcast against each other.
+
+        Returns
+        -------
+        ndarray, shape (...) or (..., C)
+            0 below the horizon. A trailing channel axis when any colour
+            parameter was given per channel.
+        """
+        wi = as_directions(wi, "wi")
+        wo = as_directions(wo, "wo")
+        shape = np.broadcast_shapes(wi.shape, wo.shape)[:-1]
+        if wi.shape[:-1] != shape or not wi.flags.c_contiguous:
+            wi = np.broadcast_to(wi, (*shape, 3))
+        if wo.shape[:-1] != shape or not wo.flags.c_contiguous:
+            wo = np.broadcast_to(wo, (*shape, 3))
+        wi2 = np.ascontiguousarray(wi.reshape(-1, 3))
+        wo2 = np.ascontiguousarray(wo.reshape(-1, 3))
+        out = np.empty((wi2.shape[0], self._packed.shape[0]))
+        eval_pairs(self.kernel, wi2, wo2, self._packed, out)
+        if self.n_channels is None:
+            return out[:, 0].reshape(shape)
+        return out.reshape(*shape, self.n_channels)
+
+    __call__ = eval
+
+    # ---------------------------------------------------------------- sampling
+    def sample(self, wo, u) -> tuple[np.ndarray, np.ndarray]:
+        """Draw wi given wo from uniform numbers *u* ∈ [0, 1]², shape (..., 2).
+
+        Returns ``(wi, pdf)`` with the solid-angle density of wi. The base
+        class samples cos θ_i/π (the fallback for models with no better
+        sampler); subclasses follow their lobes. Directions with pdf 0 must be
+        discarded by the caller.
+        """
+        wo = as_directions(wo, "wo")
+        u = as_uniform(u)
+        wi = sample_cosine_hemisphere(u)
+        wi = np.broadcast_to(wi, np.broadcast_shapes(wi.shape, wo.shape)).copy()
+        return wi, self.pdf(wi, wo)
+
+    def pdf(self, wi, wo) -> np.ndarray:
+        """Solid-angle density of :meth:`sample` for wi given wo."""
+        wi = as_directions(wi, "wi")
+        wo = as_directions(wo, "wo")
+        p = pdf_cosine_hemisphere(wi)
+        return np.where(wo[..., 2] > 0.0, p, 0.0) * np.ones(np.broadcast_shapes(
+            wi.shape, wo.shape)[:-1])
+
+    # ------------------------------------------------------------ description
+    @classmethod
+    def describe(cls) -> dict:
+        """JSON-ready description of the model class (``brdfkit models --json``)."""
+        return {
+            "name": cls.name,
+            "aliases": list(cls.aliases),
+            "summary": cls.summary,
+            "citation": cls.citation,
+            "reciprocal": cls.reciprocal,
+            "has_sampler": cls.has_sampler,
+            "beta": cls.width_param,
+            "params": [p.to_dict() for p in cls.params],
+        }
+
+
+def _check_beta(model: str, beta) -> float:
+    try:
+        b = float(beta)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{model}: 'beta' must be a number (radians); got {beta!r}") from None
+    if not (0.0 < b < math.pi / 2):
+        raise ParameterError(
+            f"{model}: 'beta' (half-angle) must lie in (0, pi/2) rad = (0, 90) deg; got {b:g} rad"
+        )
+    return b
