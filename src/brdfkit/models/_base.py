@@ -43,7 +43,32 @@ from brdfkit._array import as_directions, as_uniform
 from brdfkit.errors import ParameterError
 from brdfkit.geometry import pdf_cosine_hemisphere, sample_cosine_hemisphere
 
-__all__ = ["Param", "BRDF", "eval_pairs"]
+__all__ = ["Param", "Lobe", "BRDF", "eval_pairs"]
+
+
+@dataclass(frozen=True)
+class Lobe:
+    """Where a model's reflected energy concentrates, for lobe-aware numerics.
+
+    The albedo engine integrates in the frame of each lobe and the χ² sampling
+    tests choose their resolution from ``width``.
+
+    Attributes
+    ----------
+    kind : {"diffuse", "mirror", "half", "normal"}
+        ``diffuse``: broad, no preferred direction beyond the cosine.
+        ``mirror``: concentrated about the mirror direction R of the other
+        direction (Phong-type, a function of R·V).
+        ``half``: concentrated where the half vector H is near the normal
+        (Blinn/microfacet-type, a function of N·H).
+        ``normal``: concentrated about the normal (peaked separable models).
+    width : float
+        Angular half-width in radians (≈ the half-angle β at which the lobe
+        falls to half its peak, in the variable of ``kind``).
+    """
+
+    kind: str
+    width: float
 
 
 @dataclass(frozen=True)
@@ -200,6 +225,10 @@ class BRDF:
     reciprocal: ClassVar[bool] = True
     has_sampler: ClassVar[bool] = False
     width_param: ClassVar[str | None] = None
+    #: Parameter sets exercised by the registry-wide tests (χ², physics
+    #: properties, albedo cross-checks): a typical one first, then extreme ones
+    #: (sharp lobes, grazing-sensitive settings, coloured parameters).
+    examples: ClassVar[tuple[dict, ...]] = ({},)
     kernel: Callable
 
     # ------------------------------------------------------------------ set-up
@@ -297,6 +326,10 @@ class BRDF:
     def _pack(self) -> np.ndarray:
         rows = [self._pack_channel(self.channel_values(c)) for c in range(self.n_channels or 1)]
         return np.ascontiguousarray(np.array(rows, dtype=np.float64))
+
+    def lobes(self) -> list[Lobe]:
+        """The lobes of this parameterisation (see :class:`Lobe`); default: one diffuse."""
+        return [Lobe("diffuse", math.pi / 2)]
 
     # --------------------------------------------------------------- accessors
     @property

@@ -27,7 +27,7 @@ import numpy as np
 from brdfkit._array import as_directions, as_uniform, stack
 from brdfkit._kern import below_horizon, half
 from brdfkit.fresnel import _fresnel_conductor
-from brdfkit.models._base import BRDF, Param
+from brdfkit.models._base import BRDF, Lobe, Param
 from brdfkit.models._registry import register
 
 _jit = numba.njit(cache=True, inline="always")
@@ -143,6 +143,15 @@ class Microfacet(BRDF):
     reciprocal = True
     has_sampler = True
     kernel = _microfacet
+    examples = (
+        {},
+        {"alpha": 0.01},
+        {"distribution": "ggx", "alpha": 0.5, "eta": [0.2, 0.9, 1.1], "k": [3.9, 2.4, 2.2]},
+        {"alpha": 1.0, "eta": 1.5},
+    )
+
+    def lobes(self):
+        return [Lobe("half", float(self._values["alpha"]))]
 
     def _sample_normal(self, u: np.ndarray) -> np.ndarray:
         alpha = self._values["alpha"]

@@ -32,7 +32,7 @@ from brdfkit.geometry import (
     sample_cosine_hemisphere,
 )
 from brdfkit.halfangle import exponent_from_beta
-from brdfkit.models._base import BRDF, Param
+from brdfkit.models._base import BRDF, Lobe, Param
 from brdfkit.models._registry import register
 
 RHO_D = Param("rho_d", 0.2, 0.0, 1.0, "", "diffuse albedo", kind="colour")
@@ -123,6 +123,18 @@ class ModifiedPhong(BRDF):
     has_sampler = True
     width_param = "n"
     kernel = _modified_phong
+    examples = (
+        {},
+        {"rho_d": 0.0, "rho_s": 1.0, "n": 5000.0},
+        {"rho_d": [0.1, 0.2, 0.3], "rho_s": [0.5, 0.4, 0.3], "n": 2.0},
+    )
+
+    def lobes(self):
+        from brdfkit.halfangle import beta_from_exponent
+
+        n = self._values["n"]
+        out = [Lobe("diffuse", math.pi / 2)] if np.any(self._values["rho_d"]) else []
+        return out + [Lobe("mirror", float(beta_from_exponent(n)) if n > 0 else math.pi / 2)]
 
     @classmethod
     def width_from_beta(cls, beta: float) -> float:
