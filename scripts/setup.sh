@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Set up brdfkit on a fresh machine: create .venv/ at the repository root and
+# install brdfkit into it (editable). Idempotent: re-running only refreshes the
+# installation.
+#
+#   bash scripts/setup.sh          # brdfkit and its runtime dependencies
+#   bash scripts/setup.sh --test   # also the test extras (pytest, hypothesis, Mitsuba 3)
+#   bash scripts/setup.sh --dev    # also the test extras and ruff
+#
+# Needs only Python >= 3.11 with pip (venv module). Environment: PYTHON selects
+# the interpreter (default: python3).
+set -euo pipefail
+
+extra=""
+for arg in "$@"; do
+  case "$arg" in
+    --test) extra="[test]" ;;
+    --dev) extra="[dev]" ;;
+    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    *) echo "setup.sh: unknown option '$arg' (use --test, --dev or --help)" >&2; exit 2 ;;
+  esac
+done
+
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$root"
+py="${PYTHON:-python3}"
+
+if ! "$py" -c 'import sys; sys.exit(sys.version_info < (3, 11))' 2>/dev/null; then
+  echo "setup.sh: brdfkit needs Python >= 3.11; '$py' is $("$py" --version 2>&1)" >&2
+  exit 1
+fi
+
+if [ ! -x .venv/bin/python ]; then
+  echo "setup.sh: creating .venv/ with $("$py" --version 2>&1)"
+  "$py" -m venv .venv
+fi
+
+.venv/bin/python -m pip install -q --upgrade pip
+.venv/bin/python -m pip install -q -e ".${extra}"
+.venv/bin/python -c "import brdfkit; print('setup.sh: brdfkit', brdfkit.__version__, 'ready in .venv/')"

@@ -1,0 +1,246 @@
+"""Shared machinery of the ``brdfkit`` commands.
+
+Every command that works on one model reuses these pieces so that models are
+named, parameterised and reported the same way everywhere:
+
+- :func:`model_options` — decorator adding the ``MODEL`` argument and the
+  ``-p/--param NAME=VALUE``, ``--pump [max|controlled]`` and ``--times K``
+  options.
+- :func:`parse_param_items` — ``NAME=VALUE`` strings → keyword arguments
+  (numbers, comma-separated per-channel/per-lobe lists, choice words; ``beta``
+  in degrees → radians).
+- :func:`build_model` — the model, optionally pumped (:mod:`brdfkit.pumping`).
+- :func:`parse_direction` — ``THETA,PHI`` in degrees → unit vector.
+- :func:`handle_errors` — turn :class:`~brdfkit.errors.BrdfkitError` into
+  ``brdfkit: error: <message>`` on stderr and exit status 2.
+- :func:`emit_json` / :func:`to_jsonable` — JSON output (NumPy → lists,
+  NaN/inf → null).
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+import sys
+from collections.abc import Callable, Iterable, Mapping
+
+import click
+import numpy as np
+
+from brdfkit.errors import BrdfkitError, ParameterError
+from brdfkit.models import resolve
+
+__all__ = [
+    "EXIT_USAGE",
+    "model_options",
+    "parse_param_items",
+    "build_model",
+    "parse_direction",
+    "handle_errors",
+    "fail",
+    "to_jsonable",
+    "emit_json",
+]
+
+#: Exit status for bad input (the same as click's usage errors).
+EXIT_USAGE = 2
+
+PARAM_HELP = (
+    "Model parameter NAME=VALUE (repeatable). VALUE is a number, comma-separated "
+    "numbers for per-channel colour or per-lobe parameters (e.g. rho_d=0.1,0.2,0.3), "
+    "a word for choice parameters (e.g. distribution=ggx) or 'none' for optional ones. "
+    "'beta' (lobe half-angle) is in DEGREES here (radians in the API). "
+    "See 'brdfkit models' for each model's parameters."
+)
+
+
+# --------------------------------------------------------------------------- errors
+def fail(message: str) -> None:
+    """Print ``brdfkit: error: <message>`` (one line) on stderr and exit with status 2."""
+    one_line = " ".join(str(message).split())
+    click.echo(f"brdfkit: error: {one_line}", err=True)
+    sys.exit(EXIT_USAGE)
+
+
+def handle_errors(func: Callable) -> Callable:
+    """Decorator: a :class:`BrdfkitError` raised by *func* becomes :func:`fail`."""
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        try:
+            return func(*args, **kwargs)
+        except BrdfkitError as exc:
+            fail(str(exc))
+
+    return wrapper
+
+
+# --------------------------------------------------------------------------- parameters
+def _param_decls(cls) -> dict:
+    return {p.name: p for p in cls.params}
+
+
+def _parse_number(text: str, name: str, model: str, bounds: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise ParameterError(
+            f"{model}: parameter {name!r} must be a number{bounds}; got {text!r}"
+        ) from None
+
+
+def parse_param_items(model_name: str, items: Iterable[str] | Mapping) -> dict:
+    """Convert ``NAME=VALUE`` strings to keyword arguments for model *model_name*.
+
+    Parameters
+    ----------
+    model_name : str
+        A registered name or alias (raises :class:`~brdfkit.errors.UnknownModelError`).
+    items : iterable of str, or mapping
+        ``NAME=VALUE`` strings as typed on the command line. A mapping is
+        taken as already parsed and returned as a dict (no unit conversion).
+
+    Returns
+    -------
+    dict
+        Keyword arguments: floats, lists of floats (per channel/lobe), strings
+        (choices) or None (``none`` for optional parameters); ``beta`` is
+        converted from degrees to radians.
+
+    Raises
+    ------
+    ParameterError
+        Malformed item, repeated name or a value that is not a number.
+    """
+    cls = resolve(model_name)
+    if isinstance(items, Mapping):
+        return dict(items)
+    decls = _param_decls(cls)
+    out: dict = {}
+    for item in items:
+        name, sep, text = str(item).partition("=")
+        name, text = name.strip(), text.strip()
+        if not sep or not name or not text:
+            raise ParameterError(
+                f"parameter must be given as NAME=VALUE (e.g. -p rho_d=0.5); got {item!r}"
+            )
+        if name in out:
+            raise ParameterError(f"{cls.name}: parameter {name!r} given twice")
+        if name == "beta":
+            deg = _parse_number(text, "beta", cls.name, " of degrees in (0, 90)")
+            if not 0.0 < deg < 90.0:
+                raise ParameterError(
+                    f"{cls.name}: parameter 'beta' (half-angle, degrees on the command line) "
+                    f"must lie in (0, 90); got {text}"
+                )
+            out[name] = math.radians(deg)
+            continue
+        p = decls.get(name)
+        if p is None:
+            out[name] = text  # the model names the unknown parameter and lists the valid ones
+            continue
+        bounds = f" in {p.bounds_text()}"
+        if p.optional and text.lower() in ("none", "null"):
+            out[name] = None
+        elif p.kind == "choice":
+            out[name] = text
+        elif p.kind in ("colour", "lobes") and "," in text:
+            out[name] = [_parse_number(t.strip(), name, cls.name, bounds)
+                         for t in text.split(",")]
+        else:
+            out[name] = _parse_number(text, name, cls.name, bounds)
+    return out
+
+
+def build_model(name: str, params: Iterable[str] | Mapping = (), pump: str | None = None,
+                times: int = 1):
+    """Build model *name* from command-line parameters, pumped if asked.
+
+    Parameters
+    ----------
+    name : str
+        Registered name or alias.
+    params : iterable of ``NAME=VALUE`` str, or mapping
+        See :func:`parse_param_items`.
+    pump : {None, "max", "controlled"}
+        Apply :func:`brdfkit.pumping.pump` with this g.
+    times : int
+        How many times to pump (≥ 1; only with *pump*).
+
+    Raises
+    ------
+    BrdfkitError
+        Unknown model, bad parameter, or pumping unavailable.
+    """
+    cls = resolve(name)
+    kwargs = parse_param_items(cls.name, params)
+    m = cls(**kwargs)
+    if pump is None:
+        return m
+    if int(times) < 1:
+        raise BrdfkitError(f"--times must be >= 1; got {times}")
+    try:
+        from brdfkit.pumping import pump as pump_model
+    except ImportError:
+        raise BrdfkitError("pumping is not available (brdfkit.pumping is missing)") from None
+    return pump_model(m, g=pump, times=int(times))
+
+
+def model_options(func: Callable) -> Callable:
+    """Decorator adding ``MODEL``, ``-p/--param``, ``--pump`` and ``--times`` to a command.
+
+    The command receives ``model`` (str), ``param`` (tuple of str), ``pump``
+    (str or None) and ``times`` (int); pass them to :func:`build_model`.
+    """
+    func = click.option("--times", type=click.IntRange(min=1), default=1, show_default=True,
+                        metavar="K", help="Apply the pumping K times (with --pump).")(func)
+    func = click.option("--pump", type=click.Choice(["max", "controlled"]), default=None,
+                        help="Pump up the albedo (Neumann et al. 1999, eqs. 16-21) with "
+                             "g1 ('max') or g2 ('controlled').")(func)
+    func = click.option("-p", "--param", "param", multiple=True, metavar="NAME=VALUE",
+                        help=PARAM_HELP)(func)
+    func = click.argument("model", metavar="MODEL")(func)
+    return func
+
+
+# --------------------------------------------------------------------------- directions
+def parse_direction(text: str, option: str = "--wi") -> np.ndarray:
+    """``THETA,PHI`` in degrees (polar angle from the normal, azimuth) → unit vector (3,)."""
+    parts = str(text).split(",")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        theta, phi = (float(s) for s in parts)
+        if not (math.isfinite(theta) and math.isfinite(phi)):
+            raise ValueError
+    except ValueError:
+        raise BrdfkitError(
+            f"{option} must be THETA,PHI in degrees (e.g. {option} 30,0); got {text!r}"
+        ) from None
+    t, f = math.radians(theta), math.radians(phi)
+    return np.array([math.sin(t) * math.cos(f), math.sin(t) * math.sin(f), math.cos(t)])
+
+
+# --------------------------------------------------------------------------- JSON
+def to_jsonable(obj):
+    """Recursively convert NumPy values to JSON types; NaN and ±inf become None."""
+    if isinstance(obj, Mapping):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, list | tuple):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.bool_ | bool):
+        return bool(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, np.floating | float):
+        x = float(obj)
+        return x if math.isfinite(x) else None
+    return obj
+
+
+def emit_json(obj, *, indent: int | None = 2) -> None:
+    """Print *obj* as strict JSON on stdout (see :func:`to_jsonable`)."""
+    click.echo(json.dumps(to_jsonable(obj), indent=indent, allow_nan=False))
