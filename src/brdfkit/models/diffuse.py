@@ -5,9 +5,14 @@ Diffuse and separable models
 Public objects
 --------------
 - :class:`Lambert` — ``lambert``: ρ_d/π.
+- :class:`NeumannNeumann` — ``neumann-neumann``: the lacquer model, Lewis §3.3.
+- :class:`Minnaert` — ``minnaert``: Lewis §3.4.
+- :class:`MinnaertEnergyConserving` — ``minnaert-energy-conserving``: Lewis §4.3.
 
-(The Neumann–Neumann lacquer model and the Minnaert shaders of Lewis §3.3–3.4
-and §4.3 live here too.)
+Paper errors handled here (see :mod:`brdfkit.halfangle` and the tests):
+Lewis's β → s conversion for Neumann–Neumann is negative (wrong); Lewis's
+claim that any k_ρ ∈ [0, 1] makes the normalised Minnaert shader conserve
+energy needs k ≥ 1.
 
 References
 ----------
@@ -16,10 +21,20 @@ References
 
 from __future__ import annotations
 
-import numba
+import math
 
-from brdfkit._kern import INV_PI, below_horizon
-from brdfkit.models._base import BRDF, Param
+import numba
+import numpy as np
+
+from brdfkit._array import as_directions, as_uniform, stack
+from brdfkit._kern import INV_PI, INV_TWO_PI, below_horizon
+from brdfkit.halfangle import (
+    beta_from_minnaert_k,
+    beta_from_neumann_s,
+    minnaert_k_from_beta,
+    neumann_s_from_beta,
+)
+from brdfkit.models._base import BRDF, Lobe, Param
 from brdfkit.models._registry import register
 
 RHO_D = Param("rho_d", 0.8, 0.0, 1.0, "", "diffuse albedo (fraction of irradiance reflected)",
@@ -55,3 +70,258 @@ class Lambert(BRDF):
     reciprocal = True
     has_sampler = True
     kernel = _lambert
+
+
+# --------------------------------------------------------------------------- Neumann-Neumann
+@numba.njit(cache=True)
+def _neumann_neumann(ix, iy, iz, ox, oy, oz, p):
+    if below_horizon(iz, oz):
+        return 0.0
+    b_n, s = p[0], p[1]
+    if s == 0.0:
+        return b_n  # the lacquer is clear: a Lambertian b_N (avoids 0 * inf below)
+    # 1/iz overflows to inf only for subnormal iz; exp(-inf) = 0 is then the right limit.
+    return b_n * math.exp(-s * (1.0 / iz + 1.0 / oz - 2.0))
+
+
+@register
+class NeumannNeumann(BRDF):
+    """Neumann–Neumann "lacquer" model as written by Lewis §3.3.
+
+    f_r(S, V) = b_N exp{−s (1/(N·S) + 1/(N·V) − 2)}: a diffuse base under an
+    absorbing, non-scattering layer of optical thickness s; b_N is the value
+    at S = V = N.
+
+    ======  =======  ===========  ==============================================
+    name    default  bounds       meaning
+    ======  =======  ===========  ==============================================
+    b_N     0.25     [0, 10] 1/sr value at S = V = N (per channel)
+    s       0.5      [0, 1e4]     optical thickness; 0 is Lambertian b_N, large
+                                  values concentrate the lobe about the normal.
+                                  Or give ``beta``: s = ln2 cos β/(1 − cos β)
+    ======  =======  ===========  ==============================================
+
+    Albedo (closed form, substitute t = 1/cos θ_o):
+    a(θ_i) = 2π b_N e^{2s − s/cos θ_i} E₃(s), with E₃ the exponential
+    integral; it is largest at normal incidence, 2π b_N e^{s} E₃(s), so
+    b_N ≤ 1/(2π e^{s} E₃(s)) conserves energy (Lewis §4.3 integrates this
+    numerically, Fig. 8). Reciprocal (Lewis §5.3). The radiance always peaks
+    at the normal (Lewis §3.3, Table 2).
+
+    The β conversion printed by Lewis §3.3, s = −ln 2/(1 + cos β), is wrong
+    (negative); see :func:`brdfkit.halfangle.neumann_s_from_beta`.
+    No lobe sampler: the cosine fallback is used.
+    """
+
+    name = "neumann-neumann"
+    aliases = ("lacquer", "neumann-lacquer")
+    summary = "Neumann-Neumann lacquer: b_N exp{-s(1/N.S + 1/N.V - 2)}"
+    params = (
+        Param("b_N", 0.25, 0.0, 10.0, "1/sr", "value at S = V = N", kind="colour"),
+        Param("s", 0.5, 0.0, 1e4, "", "optical thickness of the lacquer; larger = narrower lobe"),
+    )
+    citation = "Lewis 1993 §3.3 (after Neumann & Neumann 1989)"
+    reciprocal = True
+    has_sampler = False
+    width_param = "s"
+    kernel = _neumann_neumann
+    examples = (
+        {},
+        {"b_N": 1.0, "s": 50.0},
+        {"b_N": [0.1, 0.2, 0.3], "s": 0.05},
+    )
+
+    @classmethod
+    def width_from_beta(cls, beta: float) -> float:
+        return neumann_s_from_beta(beta)
+
+    def lobes(self):
+        s = float(self._values["s"])
+        return [Lobe("normal", beta_from_neumann_s(s) if s > 0.0 else math.pi / 2)]
+
+
+# --------------------------------------------------------------------------- Minnaert
+# Minnaert's exponent k - 1 is negative for k < 1 and the lobe then diverges at
+# the horizon. Flooring each cosine at COS_FLOOR keeps every factor
+# cos^{k-1} <= COS_FLOOR^{-1} = 1e150 for all allowed k > 0, so the product of
+# the two stays below 1e300 (finite), while changing f only within 1e-150 rad
+# of the horizon -- the divergence of the albedo as theta_i -> 90 deg remains
+# visible to the analysis.
+COS_FLOOR = 1e-150
+
+
+@numba.njit(cache=True)
+def _minnaert_core(iz, oz, k):
+    e = k - 1.0
+    if e == 0.0:
+        return 1.0
+    return max(iz, COS_FLOOR) ** e * max(oz, COS_FLOOR) ** e  # floor: see COS_FLOOR
+
+
+@numba.njit(cache=True)
+def _minnaert(ix, iy, iz, ox, oy, oz, p):
+    if below_horizon(iz, oz):
+        return 0.0
+    b_m, k = p[0], p[1]
+    return b_m * _minnaert_core(iz, oz, k)
+
+
+@numba.njit(cache=True)
+def _minnaert_ec(ix, iy, iz, ox, oy, oz, p):
+    if below_horizon(iz, oz):
+        return 0.0
+    k_rho, k = p[0], p[1]
+    return k_rho * (k + 1.0) * INV_TWO_PI * _minnaert_core(iz, oz, k)
+
+
+def _sample_minnaert(model, wo, u):
+    """wi with density (k+1)/(2π) cos^k θ_i: cos θ = u₀^{1/(k+1)} (inverse CDF).
+
+    f cos θ_i is proportional to cos^k θ_i for fixed wo, so this is exact
+    importance sampling: f cos θ_i / pdf does not depend on wi.
+    """
+    wo = as_directions(wo, "wo")
+    u = as_uniform(u)
+    k = float(model._values["k"])
+    cos_t = u[..., 0] ** (1.0 / (k + 1.0))
+    sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))  # clamp: rounding at cos_t = 1
+    phi = 2.0 * np.pi * u[..., 1]
+    wi = stack(sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t)
+    wi = np.broadcast_to(wi, np.broadcast_shapes(wi.shape, wo.shape)).copy()
+    return wi, model.pdf(wi, wo)
+
+
+def _pdf_minnaert(model, wi, wo):
+    wi = as_directions(wi, "wi")
+    wo = as_directions(wo, "wo")
+    k = float(model._values["k"])
+    c = np.maximum(wi[..., 2], 0.0)
+    with np.errstate(divide="ignore"):
+        p = (k + 1.0) / (2.0 * np.pi) * np.where(c > 0.0, c, 0.0) ** k
+    p = np.where(c > 0.0, p, 0.0)
+    return np.where(wo[..., 2] > 0.0, p, 0.0)
+
+
+def _minnaert_lobes(k: float) -> list:
+    return [Lobe("normal", beta_from_minnaert_k(k) if k > 1.0 else math.pi / 2)]
+
+
+K_MINNAERT = Param("k", 2.0, 0.0, 1e4, "",
+                   "Minnaert exponent: 1 is Lambertian, > 1 peaks at the normal, < 1 brightens "
+                   "toward the limb (the Moon: ~0.5-1)", lower_open=True)
+
+
+@register
+class Minnaert(BRDF):
+    """Minnaert's lunar shader as a BRDF (Lewis §3.4).
+
+    f_r(S, V) = b_M ((N·S)(N·V))^{k−1}, from L_r = b_M (N·S)^k (N·V)^{k−1} L_i
+    (Minnaert 1941).
+
+    ======  =======  ============  =============================================
+    name    default  bounds        meaning
+    ======  =======  ============  =============================================
+    b_M     0.2      [0, 10] 1/sr  scale (per channel)
+    k       2        (0, 1e4]      exponent (Lewis's symbol). k = 1: Lambertian;
+                                   k > 1: lobe about the normal, or give
+                                   ``beta``: k = 1 − ln2/ln cos β;
+                                   k < 1: grows toward the horizon
+    ======  =======  ============  =============================================
+
+    Albedo (closed form): a(θ_i) = 2π b_M cos^{k−1}θ_i/(k+1). For k ≥ 1 it is
+    largest at normal incidence and b_M ≤ (k+1)/(2π) conserves energy; for
+    k < 1 it diverges as θ_i → 90°, so no b_M > 0 conserves energy. k < 1
+    is allowed (it is Minnaert's lunar regime) so that the analysis can
+    show the divergence; the kernel floors the cosines at 1e-150 to stay
+    finite. Reciprocal (Lewis §5.3). Sampled exactly: pdf (k+1)/(2π) cos^k θ_i.
+    """
+
+    name = "minnaert"
+    aliases = ("minnaert-lewis",)
+    summary = "Minnaert: b_M ((N.S)(N.V))^(k-1)"
+    params = (
+        Param("b_M", 0.2, 0.0, 10.0, "1/sr", "scale (value at S = V = N)", kind="colour"),
+        K_MINNAERT,
+    )
+    citation = "Lewis 1993 §3.4 (after Minnaert 1941)"
+    reciprocal = True
+    has_sampler = True
+    width_param = "k"
+    kernel = _minnaert
+    examples = (
+        {},
+        {"b_M": 1.0, "k": 200.0},
+        {"b_M": [0.1, 0.2, 0.3], "k": 0.7},
+    )
+
+    @classmethod
+    def width_from_beta(cls, beta: float) -> float:
+        return minnaert_k_from_beta(beta)
+
+    def lobes(self):
+        return _minnaert_lobes(float(self._values["k"]))
+
+    def sample(self, wo, u):
+        return _sample_minnaert(self, wo, u)
+
+    def pdf(self, wi, wo):
+        return _pdf_minnaert(self, wi, wo)
+
+
+@register
+class MinnaertEnergyConserving(BRDF):
+    """Energy-normalised Minnaert shader (Lewis §4.3).
+
+    f_r(S, V) = k_ρ (k+1)/(2π) ((N·S)(N·V))^{k−1}.
+
+    ======  =======  ========  ================================================
+    name    default  bounds    meaning
+    ======  =======  ========  ================================================
+    k_rho   0.8      [0, 1]    albedo at normal incidence (per channel)
+    k       2        (0, 1e4]  exponent; or give ``beta`` (k = 1 − ln2/ln cos β)
+    ======  =======  ========  ================================================
+
+    Albedo (derived): ∫ (N·V)^{k−1} cos θ_o dω_o = 2π/(k+1), so
+    a(θ_i) = k_ρ cos^{k−1}θ_i. Lewis states that "any value of k_ρ between 0
+    and 1 will guarantee energy conservation"; that holds only for **k ≥ 1**.
+    For 0 < k < 1 the albedo k_ρ cos^{k−1}θ_i exceeds 1 once
+    cos θ_i < k_ρ^{1/(1−k)} and diverges at grazing incidence. We keep
+    0 < k < 1 allowed (finite kernel: cosines floored at 1e-150, so f < 1e300)
+    so that the plausibility analysis can detect this divergence, and state it
+    here instead of silently bounding k ≥ 1.
+
+    Reciprocal. Sampled exactly: pdf (k+1)/(2π) cos^k θ_i, for which
+    f cos θ_i/pdf = k_ρ cos^{k−1}θ_o.
+    """
+
+    name = "minnaert-energy-conserving"
+    aliases = ("minnaert-ec", "minnaert-normalised", "minnaert-normalized")
+    summary = "energy-normalised Minnaert: k_rho (k+1)/2pi ((N.S)(N.V))^(k-1)"
+    params = (
+        Param("k_rho", 0.8, 0.0, 1.0, "", "albedo at normal incidence", kind="colour"),
+        K_MINNAERT,
+    )
+    citation = "Lewis 1993 §4.3"
+    reciprocal = True
+    has_sampler = True
+    width_param = "k"
+    kernel = _minnaert_ec
+    examples = (
+        {},
+        {"k_rho": 1.0, "k": 200.0},
+        {"k_rho": [0.2, 0.5, 0.9], "k": 1.0},
+        {"k_rho": 0.5, "k": 0.5},
+    )
+
+    @classmethod
+    def width_from_beta(cls, beta: float) -> float:
+        return minnaert_k_from_beta(beta)
+
+    def lobes(self):
+        return _minnaert_lobes(float(self._values["k"]))
+
+    def sample(self, wo, u):
+        return _sample_minnaert(self, wo, u)
+
+    def pdf(self, wi, wo):
+        return _pdf_minnaert(self, wi, wo)
