@@ -96,7 +96,7 @@ class NeumannNeumann(BRDF):
     name    default  bounds       meaning
     ======  =======  ===========  ==============================================
     b_N     0.25     [0, 10] 1/sr value at S = V = N (per channel)
-    s       0.5      [0, 1e4]     optical thickness; 0 is Lambertian b_N, large
+    s       0.5      [0, 1e7]     optical thickness; 0 is Lambertian b_N, large
                                   values concentrate the lobe about the normal.
                                   Or give ``beta``: s = ln2 cos β/(1 − cos β)
     ======  =======  ===========  ==============================================
@@ -118,7 +118,7 @@ class NeumannNeumann(BRDF):
     summary = "Neumann-Neumann lacquer: b_N exp{-s(1/N.S + 1/N.V - 2)}"
     params = (
         Param("b_N", 0.25, 0.0, 10.0, "1/sr", "value at S = V = N", kind="colour"),
-        Param("s", 0.5, 0.0, 1e4, "", "optical thickness of the lacquer; larger = narrower lobe"),
+        Param("s", 0.5, 0.0, 1e7, "", "optical thickness of the lacquer; larger = narrower lobe"),
     )
     citation = "Lewis 1993 §3.3 (after Neumann & Neumann 1989)"
     reciprocal = True
@@ -206,7 +206,7 @@ def _minnaert_lobes(k: float) -> list:
     return [Lobe("normal", beta_from_minnaert_k(k) if k > 1.0 else math.pi / 2)]
 
 
-K_MINNAERT = Param("k", 2.0, 0.0, 1e4, "",
+K_MINNAERT = Param("k", 2.0, 0.0, 1e7, "",
                    "Minnaert exponent: 1 is Lambertian, > 1 peaks at the normal, < 1 brightens "
                    "toward the limb (the Moon: ~0.5-1)", lower_open=True)
 
@@ -222,7 +222,7 @@ class Minnaert(BRDF):
     name    default  bounds        meaning
     ======  =======  ============  =============================================
     b_M     0.2      [0, 10] 1/sr  scale (per channel)
-    k       2        (0, 1e4]      exponent (Lewis's symbol). k = 1: Lambertian;
+    k       2        (0, 1e7]      exponent (Lewis's symbol). k = 1: Lambertian;
                                    k > 1: lobe about the normal, or give
                                    ``beta``: k = 1 − ln2/ln cos β;
                                    k < 1: grows toward the horizon
@@ -278,7 +278,7 @@ class MinnaertEnergyConserving(BRDF):
     name    default  bounds    meaning
     ======  =======  ========  ================================================
     k_rho   0.8      [0, 1]    albedo at normal incidence (per channel)
-    k       2        (0, 1e4]  exponent; or give ``beta`` (k = 1 − ln2/ln cos β)
+    k       2        (0, 1e7]  exponent; or give ``beta`` (k = 1 − ln2/ln cos β)
     ======  =======  ========  ================================================
 
     Albedo (derived): ∫ (N·V)^{k−1} cos θ_o dω_o = 2π/(k+1), so

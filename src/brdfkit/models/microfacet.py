@@ -337,7 +337,7 @@ class _HalfVectorSampling:
 ETA_DIELECTRIC = Param("eta", None, 0.0, 100.0, "",
                        "index of refraction (dielectric Fresnel); none: F = 1",
                        kind="colour", lower_open=True, optional=True)
-M_SLOPE = Param("m", 0.1, 1e-4, 10.0, "",
+M_SLOPE = Param("m", 0.1, 1e-4, 100.0, "",
                 "RMS slope: 0.01 near-mirror, 0.1 glossy, 0.5 rough")
 
 
@@ -393,7 +393,7 @@ class TorranceSparrow(_HalfVectorSampling, BRDF):
     c             None        (0, 1e3]      c₂ of D₂ (default 4) or c₃ of D₃
                                             (default 0.3; must be ≤ 1 so that D₃
                                             peaks at α = 0)
-    m             0.1         [1e-4, 10]    RMS slope of D₄
+    m             0.1         [1e-4, 100]   RMS slope of D₄
     eta           None        (0, 100]      index of refraction; None: F = 1
     ============  ==========  ============  ========================================
 
@@ -529,7 +529,7 @@ class CookTorrance(_HalfVectorSampling, BRDF):
     =====  =======  ===========  ==============================================
     name   default  bounds       meaning
     =====  =======  ===========  ==============================================
-    m      0.1      [1e-4, 10]   RMS slope; or give ``beta`` (Lewis's D₄ m(β))
+    m      0.1      [1e-4, 100]  RMS slope; or give ``beta`` (Lewis's D₄ m(β))
     eta    None     (0, 100]     index of refraction (per channel); None: F = 1
     rho_s  1        [0, 1]       scale (per channel)
     =====  =======  ===========  ==============================================
@@ -597,7 +597,7 @@ class Ward(_HalfVectorSampling, BRDF):
     =====  =======  ===========  ==============================================
     rho_d  0        [0, 1]       diffuse albedo (per channel)
     rho_s  1        [0, 1]       specular albedo scale (per channel)
-    m      0.1      [1e-4, 10]   RMS slope; or ``beta``: m = tan β/√ln2
+    m      0.1      [1e-4, 100]  RMS slope; or ``beta``: m = tan β/√ln2
     =====  =======  ===========  ==============================================
 
     Reciprocal. The specular albedo is close to ρ_s at normal incidence for
