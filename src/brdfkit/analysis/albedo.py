@@ -1,0 +1,756 @@
+"""
+Directional albedo by lobe-aware deterministic quadrature
+=========================================================
+
+a(ω_i) = ∫_Ω f_r(ω_i, ω_o) cos θ_o dω_o (Lewis's k_ρ, eq. 15; Neumann's
+albedo) to ~1e-7 absolute, with an error estimate, for lobes as sharp as
+Phong n = 10⁴ or Beckmann α = 0.01 and at incidence up to 89.999°.
+
+Method
+------
+The outgoing hemisphere is parametrised by polar coordinates (t, φ) about
+the axis of the model's sharpest lobe (:meth:`BRDF.lobes`):
+
+- ``mirror`` lobes: about the mirror direction R of ω_i,
+  ω_o = cos t R + sin t (cos φ e₁ + sin φ e₂), dω_o = sin t dt dφ;
+- ``half`` lobes: over the half vector h = (sin t cos φ, sin t sin φ, cos t),
+  ω_o = 2(ω_i·h)h − ω_i, dω_o = 4(ω_i·h) sin t dt dφ;
+- ``diffuse`` / ``normal`` lobes: about the normal, dω_o = sin t dt dφ.
+
+For each t the azimuths with ω_o above the horizon form one interval
+[0, φ_max(t)] whose end is known in closed form (mirror: cos φ_max =
+−cot t cot θ_i; half: cos φ_max = −cos θ_i cos 2t/(sin θ_i sin 2t)), so the
+horizon cut never falls inside a quadrature panel. In half-vector space the
+azimuths where the V-groove G = min(1, 2(N·H)(N·V)/(V·H), 2(N·H)(N·L)/(L·H))
+switches branch are also break points (closed forms in :func:`_phi_breaks`).
+The t axis is split at the horizon-tangency angles and graded geometrically
+at w, 3w, 9w … for lobe width w. Every panel uses a smoothstep change of
+variable (which removes √-type endpoint singularities such as Ward's
+1/√(N·V)) and a 15-point Gauss–Kronrod rule in t and in φ; the embedded
+7-point Gauss rule gives an error estimate (a QUADPACK-type heuristic, see
+:func:`_reduce`). If the
+estimate exceeds the tolerance every panel is halved in both directions and
+the angle recomputed (up to 5 times).
+
+Isotropic models are integrated over φ ∈ [0, φ_max] and doubled (mirror
+symmetry about the plane of incidence); plain callables over both halves.
+
+Public objects
+--------------
+- :class:`AlbedoResult` — θ_i, albedo, error estimate.
+- :func:`albedo` — deterministic albedo of a model or callable.
+- :func:`albedo_mc` — importance-sampled Monte-Carlo estimate (cross-check).
+- :func:`hemispherical_albedo` — ρ_hh = (1/π) ∫ a(ω_i) cos θ_i dω_i.
+- :func:`H_s` — Lewis's specular integral H_s(S) (§4.1, Fig. 5).
+
+References
+----------
+- [Lewis1993] eqs. (15)–(19), Fig. 5.
+- [Neumann1999] §2, Fig. 1.
+- R. Piessens et al., QUADPACK (1983): Gauss–Kronrod 7–15 and its error heuristic.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from brdfkit.errors import BrdfkitError, ParameterError
+
+__all__ = ["AlbedoResult", "albedo", "albedo_mc", "hemispherical_albedo", "H_s", "lobe_frame"]
+
+NORMAL, MIRROR, HALF = 0, 1, 2
+_MODE = {"diffuse": NORMAL, "normal": NORMAL, "mirror": MIRROR, "half": HALF}
+MAX_LEVEL = 5
+GRADE = 2.0  # geometric grading of the t panels: w, 2w, 4w, ...
+
+# 15-point Kronrod nodes (abscissae on [-1, 1], positive half) and weights, with the
+# weights of the embedded 7-point Gauss rule (QUADPACK dqk15).
+_XGK = np.array([0.991455371120812639206854697526329, 0.949107912342758524526189684047851,
+                 0.864864423359769072789712788640926, 0.741531185599394439863864773280788,
+                 0.586087235467691130294144845693013, 0.405845151377397166906606412076961,
+                 0.207784955007898467600689403773245, 0.000000000000000000000000000000000])
+_WGK = np.array([0.022935322010529224963732008058970, 0.063092092629978553290700663189204,
+                 0.104790010322250183839876322541518, 0.140653259715525918745189590510238,
+                 0.169004726639267902826583426598550, 0.190350578064785409913256402421014,
+                 0.204432940075298892414161999234649, 0.209482141084727828012999174891714])
+_WG = np.array([0.129484966168869693270611432679082, 0.279705391489276667901467771423780,
+                0.381830050505118944950369775488975, 0.417959183673469387755102040816327])
+
+
+def _unit_rule() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """GK15 on [0, 1] after the smoothstep map x = 3u² − 2u³ (nodes, Kronrod, Gauss weights)."""
+    u = np.concatenate([-_XGK[:-1], _XGK[::-1]])
+    wk = np.concatenate([_WGK[:-1], _WGK[::-1]])
+    wg = np.zeros(15)
+    # Gauss nodes are the odd-indexed Kronrod nodes ±_XGK[1], ±_XGK[3], ±_XGK[5], 0
+    for j, i in enumerate((1, 3, 5)):
+        wg[i] = wg[14 - i] = _WG[j]
+    wg[7] = _WG[3]
+    order = np.argsort(u)
+    u, wk, wg = (u[order] + 1.0) / 2.0, wk[order] / 2.0, wg[order] / 2.0
+    x = 3.0 * u * u - 2.0 * u ** 3
+    jac = 6.0 * u * (1.0 - u)
+    return x, wk * jac, wg * jac
+
+
+_X, _WK, _WGAUSS = _unit_rule()
+
+
+# --------------------------------------------------------------------------- geometry
+@numba.njit(cache=True)
+def _t_max(mode, theta):
+    if mode == MIRROR:
+        return math.pi - (0.5 * math.pi - theta) if theta > 0.0 else 0.5 * math.pi
+    if mode == HALF:
+        return 0.5 * (0.5 * math.pi + theta)
+    return 0.5 * math.pi
+
+
+@numba.njit(cache=True)
+def _t_breaks(mode, theta, width, out):
+    """Sorted break points of the t axis (including 0 and t_max); returns their count."""
+    tmax = _t_max(mode, theta)
+    e = 0.5 * math.pi - theta  # elevation of ω_i (and of R) above the horizon
+    cand = np.empty(64)
+    n = 0
+    cand[n] = 0.0
+    n += 1
+    cand[n] = tmax
+    n += 1
+    if mode == MIRROR:
+        cand[n] = e  # circle about R first touches the horizon
+        n += 1
+    elif mode == HALF:
+        cand[n] = 0.5 * e  # the half-vector circle first maps below the horizon
+        cand[n + 1] = e  # V-groove kink 2(N·H)(N·L) = L·H reaches φ = 0
+        cand[n + 2] = theta  # V-groove kink N·V = N·L reaches φ = 0
+        n += 3
+    w = max(min(width, 0.5 * math.pi), 1e-9)
+    b = w
+    while b < tmax and n < 60:
+        cand[n] = b
+        n += 1
+        b *= GRADE
+    # sort, keep points inside [0, tmax], drop near-duplicates
+    srt = np.sort(cand[:n])
+    m = 0
+    for i in range(n):
+        x = srt[i]
+        if x < 0.0 or x > tmax:
+            continue
+        if m > 0 and x - out[m - 1] <= 1e-13 * (1.0 + tmax):
+            continue
+        out[m] = x
+        m += 1
+    if out[m - 1] < tmax:
+        out[m] = tmax
+        m += 1
+    return m
+
+
+@numba.njit(cache=True)
+def _phi_breaks(mode, t, s, c, out):
+    """Break points 0 = b₀ < … < b_k = φ_max of the azimuth at polar angle t; returns k + 1.
+
+    φ_max is where ω_o meets the horizon (closed form). In half-vector mode
+    the azimuths where the branches of the V-groove G cross are added:
+    2(N·H)(N·L) = L·H, 2(N·H)(N·V) = V·H, and N·V = N·L, each of the form
+    cos φ = (d* − c cos t)/(s sin t) for the value d* of ω_i·h on that curve.
+    """
+    st = math.sin(t)
+    ct = math.cos(t)
+    if mode == NORMAL:
+        out[0] = 0.0
+        out[1] = math.pi
+        return 2
+    if mode == MIRROR:
+        num = -ct * c
+        den = st * s
+    else:
+        num = -c * (ct * ct - st * st)  # −cos θ cos 2t
+        den = s * 2.0 * st * ct  # sin θ sin 2t
+    if den <= 1e-300:
+        # normal incidence or t = 0: the whole circle is above the horizon iff num < 0
+        phimax = math.pi if num < 0.0 else 0.0
+    else:
+        c0 = num / den
+        if c0 <= -1.0:
+            phimax = math.pi
+        elif c0 >= 1.0:
+            phimax = 0.0
+        else:
+            phimax = math.acos(c0)
+    out[0] = 0.0
+    k = 1
+    if mode == HALF and s * st > 1e-300 and phimax > 0.0:
+        dstar = np.empty(3)
+        nd = 0
+        dstar[nd] = 2.0 * ct * c  # 2(N·H)(N·L) = L·H
+        nd += 1
+        dstar[nd] = c / ct if ct > 0.0 else -1.0  # N·V = N·L: 2 d cos t − c = c
+        nd += 1
+        if 4.0 * ct * ct > 1.0:
+            dstar[nd] = 2.0 * ct * c / (4.0 * ct * ct - 1.0)  # 2(N·H)(N·V) = V·H
+            nd += 1
+        for i in range(nd):
+            cp = (dstar[i] - c * ct) / (s * st)
+            if -1.0 < cp < 1.0:
+                ph = math.acos(cp)
+                if 1e-12 < ph < phimax - 1e-12:
+                    out[k] = ph
+                    k += 1
+        # insertion sort of out[1:k]
+        for i in range(2, k):
+            v = out[i]
+            j = i - 1
+            while j >= 1 and out[j] > v:
+                out[j + 1] = out[j]
+                j -= 1
+            out[j + 1] = v
+    out[k] = phimax
+    return k + 1
+
+
+@numba.njit(cache=True, inline="always")
+def _direction(mode, st, ct, phi, s, c):
+    """ω_o at (t, φ) (given sin t, cos t) and dω_o/(dt dφ)·cos θ_o (0 below the horizon)."""
+    sp = math.sin(phi)
+    cp = math.cos(phi)
+    if mode == MIRROR:
+        # R = (−s, 0, c), e₁ = (c, 0, s), e₂ = (0, 1, 0)
+        ox = -s * ct + st * cp * c
+        oy = st * sp
+        oz = c * ct + st * cp * s
+        jac = st
+    elif mode == HALF:
+        hx = st * cp
+        hy = st * sp
+        d = s * hx + c * ct  # ω_i·h
+        ox = 2.0 * d * hx - s
+        oy = 2.0 * d * hy
+        oz = 2.0 * d * ct - c
+        jac = 4.0 * d * st
+        if d <= 0.0:
+            jac = 0.0
+    else:
+        ox = st * cp
+        oy = st * sp
+        oz = ct
+        jac = st
+    if oz <= 0.0:
+        return ox, oy, 0.0, 0.0  # rounding at the horizon: contributes nothing
+    return ox, oy, oz, jac * oz
+
+
+@numba.njit(cache=True)
+def _count_nodes(mode, theta, width, level, sym):
+    tb = np.empty(64)
+    nt = _t_breaks(mode, theta, width, tb)
+    sub = 1 << level
+    n_int = 5 if mode == HALF else 1
+    halves = 1 if sym else 2
+    return (nt - 1) * sub * 15 * n_int * sub * 15 * halves, (nt - 1) * sub * halves
+
+
+@numba.njit(cache=True)
+def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece):
+    """Fill the nodes of one incidence angle; returns the number written.
+
+    wo (N, 3), wk / wg (N,) Kronrod / Gauss weights including the measure and
+    cos θ_o, piece (N,) the 2-D panel each node belongs to.
+    """
+    s = math.sin(theta)
+    c = math.cos(theta)
+    tb = np.empty(64)
+    nt = _t_breaks(mode, theta, width, tb)
+    sub = 1 << level
+    n_int = 5 if mode == HALF else 1
+    halves = 1 if sym else 2
+    fac = 2.0 if sym else 1.0
+    pb = np.empty(8)
+    n = 0
+    tp = 0
+    for ip in range(nt - 1):
+        for q in range(sub):
+            a = tb[ip] + (tb[ip + 1] - tb[ip]) * q / sub
+            b = tb[ip] + (tb[ip + 1] - tb[ip]) * (q + 1) / sub
+            for it in range(15):
+                t = a + (b - a) * X[it]
+                wtk = WK[it] * (b - a)
+                wtg = WG[it] * (b - a)
+                k = _phi_breaks(mode, t, s, c, pb)
+                st = math.sin(t)
+                ct = math.cos(t)
+                for h in range(halves):
+                    sign = 1.0 if h == 0 else -1.0
+                    for j in range(n_int):
+                        if j < k - 1:
+                            pa = pb[j]
+                            pz = pb[j + 1]
+                        else:
+                            pa = 0.0
+                            pz = 0.0
+                        for r in range(sub):
+                            fa = pa + (pz - pa) * r / sub
+                            fb = pa + (pz - pa) * (r + 1) / sub
+                            # one error piece per t sub-panel and half: the azimuth break
+                            # points move with t, so only the strip's total is smooth in t
+                            pid = tp * halves + h
+                            for iph in range(15):
+                                phi = sign * (fa + (fb - fa) * X[iph])
+                                ox, oy, oz, jac = _direction(mode, st, ct, phi, s, c)
+                                wo[n, 0] = ox
+                                wo[n, 1] = oy
+                                wo[n, 2] = oz
+                                wk[n] = fac * jac * wtk * WK[iph] * (fb - fa)
+                                wg[n] = fac * jac * wtg * WG[iph] * (fb - fa)
+                                piece[n] = pid
+                                n += 1
+            tp += 1
+    return n
+
+
+@numba.njit(cache=True)
+def _reduce(vals, wk, wg, piece, n_pieces, n, C, out_a, out_e):
+    """Sum the Kronrod estimate and the QUADPACK-style error over the panels."""
+    K = np.zeros((n_pieces, C))
+    G = np.zeros((n_pieces, C))
+    A = np.zeros((n_pieces, C))
+    for i in range(n):
+        p = piece[i]
+        for ch in range(C):
+            v = vals[i, ch]
+            K[p, ch] += wk[i] * v
+            G[p, ch] += wg[i] * v
+            A[p, ch] += abs(wk[i] * v)
+    for ch in range(C):
+        tot = 0.0
+        err = 0.0
+        for p in range(n_pieces):
+            tot += K[p, ch]
+            d = abs(K[p, ch] - G[p, ch])
+            if A[p, ch] > 0.0 and d > 0.0:
+                # |K − G| estimates the error of the 7-point Gauss rule; for an analytic
+                # integrand the 15-point Kronrod error is ~ A (|K − G|/A)^(23/14) (orders
+                # 14 and 23 on a panel). We take the exponent 1.5 (QUADPACK's, without
+                # its factor 200^1.5, which overestimates by ~1e5 here; see the tests
+                # against closed forms) and never more than |K − G| itself.
+                r = d / A[p, ch]
+                err += min(d, A[p, ch] * r * math.sqrt(r))
+        out_a[ch] = tot
+        out_e[ch] = err + 1e-15 * abs(tot)  # floor: rounding of the sum
+
+
+@numba.njit(cache=True, parallel=True)
+def _gen_all(mode, thetas, width, levels, sym, X, WK, WG, offsets, wo, wk, wg, piece):
+    """Nodes of every angle i at its level, written at offsets[i] (parallel over angles)."""
+    for i in numba.prange(thetas.shape[0]):
+        o = offsets[i]
+        m = offsets[i + 1] - o
+        n = _gen_nodes(mode, thetas[i], width, levels[i], sym, X, WK, WG, wo[o:o + m],
+                       wk[o:o + m], wg[o:o + m], piece[o:o + m])
+        for j in range(n, m):  # unused slots (none in practice): weight 0
+            wo[o + j, 0] = 0.0
+            wo[o + j, 1] = 0.0
+            wo[o + j, 2] = 1.0
+            wk[o + j] = 0.0
+            wg[o + j] = 0.0
+            piece[o + j] = 0
+
+
+@numba.njit(cache=True, parallel=True)
+def _reduce_all(vals, wk, wg, piece, offsets, npieces, out_a, out_e):
+    for i in numba.prange(offsets.shape[0] - 1):
+        o = offsets[i]
+        m = offsets[i + 1] - o
+        _reduce(vals[o:o + m], wk[o:o + m], wg[o:o + m], piece[o:o + m], npieces[i], m,
+                vals.shape[1], out_a[i], out_e[i])
+
+
+# Not cached: Numba cannot reliably cache functions that take another compiled
+# function as an argument (the cache index pickles the dispatcher's type, and
+# loading it in a later process fails with "underlying object has vanished").
+@numba.njit(parallel=True)
+def _eval_kernel(kernel, P, thetas, offsets, wo, vals):  # pragma: no cover - compiled
+    """vals[j, c] = kernel(ω_i(θ of j), wo[j], P[c]); NaN/inf replaced by 0."""
+    for i in numba.prange(thetas.shape[0]):
+        ix = math.sin(thetas[i])
+        iz = math.cos(thetas[i])
+        for j in range(offsets[i], offsets[i + 1]):
+            for ch in range(P.shape[0]):
+                if wo[j, 2] <= 0.0:
+                    vals[j, ch] = 0.0
+                    continue
+                v = kernel(ix, 0.0, iz, wo[j, 0], wo[j, 1], wo[j, 2], P[ch])
+                vals[j, ch] = v if math.isfinite(v) else 0.0  # guard: never propagate NaN
+
+
+def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool, tol: float,
+               n_channels: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Level loop shared by the compiled and the callable paths.
+
+    ``evaluate(thetas, offsets, wo) -> vals (N, C)`` evaluates f at the nodes.
+    """
+    n = thetas.size
+    a = np.zeros((n, n_channels))
+    e = np.full((n, n_channels), np.inf)
+    levels = np.zeros(n, dtype=np.int64)
+    todo = np.arange(n)
+    for level in range(MAX_LEVEL + 1):
+        th = np.ascontiguousarray(thetas[todo])
+        lv = np.full(th.size, level, dtype=np.int64)
+        counts = np.empty(th.size, dtype=np.int64)
+        npieces = np.empty(th.size, dtype=np.int64)
+        for k, t in enumerate(th):
+            counts[k], npieces[k] = _count_nodes(mode, float(t), width, level, sym)
+        offsets = np.zeros(th.size + 1, dtype=np.int64)
+        np.cumsum(counts, out=offsets[1:])
+        total = int(offsets[-1])
+        wo = np.empty((total, 3))
+        wk = np.empty(total)
+        wg = np.empty(total)
+        piece = np.empty(total, dtype=np.int64)
+        _gen_all(mode, th, width, lv, sym, _X, _WK, _WGAUSS, offsets, wo, wk, wg, piece)
+        vals = np.ascontiguousarray(evaluate(th, offsets, wo), dtype=np.float64)
+        aa = np.empty((th.size, vals.shape[1]))
+        ee = np.empty_like(aa)
+        _reduce_all(vals, wk, wg, piece, offsets, npieces, aa, ee)
+        a[todo] = aa
+        e[todo] = ee
+        levels[todo] = level
+        bad = np.any(ee > np.maximum(tol, 1e-10 * np.abs(aa)), axis=1)
+        todo = todo[bad]
+        if todo.size == 0:
+            break
+    return a, e, levels
+
+
+# --------------------------------------------------------------------------- public API
+@dataclass(frozen=True)
+class AlbedoResult:
+    """Directional albedo at the incidence angles θ_i.
+
+    Attributes
+    ----------
+    theta : ndarray
+        θ_i in radians (shape of the input; 0-d for a scalar).
+    albedo : ndarray
+        a(θ_i), shape ``theta.shape`` or ``theta.shape + (C,)`` for coloured models.
+    error : ndarray
+        Error estimate (absolute), same shape as ``albedo``.
+    """
+
+    theta: np.ndarray
+    albedo: np.ndarray
+    error: np.ndarray
+
+    def to_dict(self) -> dict:
+        """JSON-ready: θ in degrees, albedo and error (per-channel lists when coloured)."""
+        return {"theta_deg": np.degrees(self.theta).tolist(),
+                "albedo": np.asarray(self.albedo).tolist(),
+                "error": np.asarray(self.error).tolist()}
+
+
+def lobe_frame(model) -> tuple[int, float]:
+    """(mode, width) of the integration frame: the frame of the sharpest lobe."""
+    lobes = model.lobes() if hasattr(model, "lobes") else []
+    if not lobes:
+        return NORMAL, math.pi / 2
+    best = min(lobes, key=lambda lb: lb.width)
+    kinds = {lb.kind for lb in lobes}
+    mode = _MODE.get(best.kind, NORMAL)
+    width = float(best.width)
+    if not math.isfinite(width) or width <= 0.0:
+        width = math.pi / 2
+    if mode == NORMAL and ("mirror" in kinds or "half" in kinds):
+        mode = _MODE[next(lb.kind for lb in lobes if lb.kind in ("mirror", "half"))]
+    return mode, min(width, math.pi / 2)
+
+
+def _check_theta(theta_i) -> np.ndarray:
+    th = np.asarray(theta_i, dtype=np.float64)
+    if not np.all(np.isfinite(th)):
+        raise ParameterError("theta_i must be finite (radians)")
+    if np.any((th < 0.0) | (th >= math.pi / 2)):
+        bad = th[(th < 0.0) | (th >= math.pi / 2)].flat[0]
+        raise ParameterError(
+            f"theta_i must lie in [0, pi/2) radians = [0, 90) degrees; got {bad!r} rad")
+    return th
+
+
+def _check_tol(tol: float) -> float:
+    try:
+        t = float(tol)
+    except (TypeError, ValueError):
+        raise ParameterError(f"tol must be a positive number; got {tol!r}") from None
+    if not (t > 0.0 and math.isfinite(t)):
+        raise ParameterError(f"tol must be a positive number; got {tol!r}")
+    return t
+
+
+def _is_compiled(model) -> bool:
+    kernel = getattr(model, "kernel", None)
+    return hasattr(model, "packed") and hasattr(kernel, "py_func")  # a Numba dispatcher
+
+
+def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
+           width: float | None = None) -> AlbedoResult:
+    """Directional albedo a(θ_i) = ∫ f_r(ω_i, ω_o) cos θ_o dω_o, deterministic.
+
+    Parameters
+    ----------
+    model : BRDF or callable
+        A brdfkit model (integrated through its compiled kernel, in the frame
+        of its sharpest lobe) or any callable ``f(wi, wo) -> array`` taking
+        broadcastable (..., 3) arrays and returning (...) or (..., C).
+        ω_i lies in the xz-plane at azimuth 0.
+    theta_i : float or array_like
+        Incidence angles in radians, in [0, π/2).
+    tol : float, keyword-only
+        Absolute accuracy goal (default 1e-7). Panels are halved until the
+        error estimate meets it (or a relative 1e-10), at most 5 times.
+    mode : {"diffuse", "mirror", "half"}, optional
+        Override the integration frame (default: from ``model.lobes()``;
+        ``diffuse`` for callables without ``lobes``).
+    width : float, optional
+        Override the lobe width (radians) that grades the panels.
+
+    Returns
+    -------
+    AlbedoResult
+        ``theta``, ``albedo`` and ``error`` (absolute error estimate).
+        Models with a ``specular_albedo(theta)`` method (a delta term not in
+        the kernel, e.g. He–Torrance) have it added, with no extra error.
+
+    Examples
+    --------
+    >>> import brdfkit, numpy as np
+    >>> from brdfkit.analysis import albedo
+    >>> r = albedo(brdfkit.model("lambert", rho_d=0.5), np.radians([0, 60, 89]))
+    >>> np.allclose(r.albedo, 0.5)
+    True
+    """
+    th = _check_theta(theta_i)
+    tol = _check_tol(tol)
+    m_mode, m_width = lobe_frame(model)
+    if mode is not None:
+        if mode not in _MODE:
+            raise ParameterError(f"mode must be one of {', '.join(_MODE)}; got {mode!r}")
+        m_mode = _MODE[mode]
+    if width is not None:
+        if not (float(width) > 0.0):
+            raise ParameterError(f"width must be > 0 radians; got {width!r}")
+        m_width = float(width)
+    flat = np.ascontiguousarray(th.reshape(-1))
+    if _is_compiled(model):
+        P = np.ascontiguousarray(np.asarray(model.packed, dtype=np.float64))
+        sym = bool(getattr(model, "isotropic", True))
+        kernel = model.kernel
+
+        def evaluate(th, offsets, wo):
+            vals = np.empty((wo.shape[0], P.shape[0]))
+            _eval_kernel(kernel, P, th, offsets, wo, vals)
+            return vals
+
+        a, e, _ = _integrate(evaluate, flat, m_mode, m_width, sym, tol, P.shape[0])
+        coloured = getattr(model, "n_channels", None) is not None
+    elif callable(model):
+        a, e, coloured = _albedo_callable(model, flat, m_mode, m_width, tol)
+    else:
+        raise BrdfkitError(f"albedo: model must be a BRDF or a callable f(wi, wo); got "
+                           f"{type(model).__name__}")
+    spec = getattr(model, "specular_albedo", None)
+    if callable(spec):
+        extra = np.asarray(spec(flat), dtype=np.float64).reshape(flat.size, -1)
+        a = a + extra
+    if coloured:
+        shape = th.shape + (a.shape[1],)
+    else:
+        a, e = a[:, 0], e[:, 0]
+        shape = th.shape
+    return AlbedoResult(theta=th.copy(), albedo=a.reshape(shape), error=e.reshape(shape))
+
+
+def _albedo_callable(f: Callable, flat: np.ndarray, mode: int, width: float, tol: float):
+    """Same rule as the compiled path; nodes built in Numba, f evaluated vectorised."""
+    shape_info = {}
+
+    def evaluate(th, offsets, wo):
+        idx = np.repeat(np.arange(th.size), np.diff(offsets))
+        wi = np.stack([np.sin(th[idx]), np.zeros(idx.size), np.cos(th[idx])], axis=-1)
+        vals = np.asarray(f(wi, wo), dtype=np.float64)
+        if vals.shape[:1] != (wo.shape[0],) or vals.ndim > 2:
+            raise BrdfkitError(f"albedo: the callable returned shape {vals.shape} for "
+                               f"{wo.shape[0]} direction pairs; expected (N,) or (N, C)")
+        shape_info["coloured"] = vals.ndim == 2
+        vals = np.where(np.isfinite(vals), vals, 0.0).reshape(wo.shape[0], -1)
+        return np.where((wo[:, 2] > 0.0)[:, None], vals, 0.0)
+
+    probe = evaluate(np.array([0.0]), np.array([0, 1]), np.array([[0.0, 0.0, 1.0]]))
+    a, e, _ = _integrate(evaluate, flat, mode, width, False, tol, probe.shape[1])
+    return a, e, shape_info["coloured"]
+
+
+# --------------------------------------------------------------------------- Monte Carlo
+def albedo_mc(model, theta_i, *, n_samples: int = 100_000, rng=None,
+              defensive: float = 0.1) -> AlbedoResult:
+    """Importance-sampled Monte-Carlo albedo with its standard error.
+
+    Directions are drawn from the mixture (1 − δ)·model.sample(·| ω_i) + δ·cos θ/π
+    (δ = ``defensive``; the cosine part keeps the estimator unbiased where the
+    model's sampler misses part of the support), and the estimator is
+    f(ω_i, ω) cos θ / pdf_mix(ω). Callables use cosine sampling only.
+
+    Parameters
+    ----------
+    model : BRDF or callable
+    theta_i : float or array_like
+        Radians in [0, π/2).
+    n_samples : int, keyword-only
+        Samples per angle.
+    rng : int or numpy.random.Generator, keyword-only
+        Seed or generator (required for reproducibility; None draws fresh entropy).
+    defensive : float, keyword-only
+        Weight of the cosine component in (0, 1].
+
+    Returns
+    -------
+    AlbedoResult
+        ``error`` is the standard error of the mean (1σ).
+    """
+    from brdfkit.geometry import pdf_cosine_hemisphere, sample_cosine_hemisphere
+
+    th = _check_theta(theta_i)
+    n_samples = int(n_samples)
+    if n_samples < 2:
+        raise ParameterError(f"n_samples must be >= 2; got {n_samples}")
+    if not (0.0 < defensive <= 1.0):
+        raise ParameterError(f"defensive must lie in (0, 1]; got {defensive!r}")
+    gen = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
+    has_sampler = bool(getattr(model, "has_sampler", False)) and hasattr(model, "sample")
+    if not has_sampler:
+        defensive = 1.0
+    vals_a, vals_e = [], []
+    for theta in th.reshape(-1):
+        wi = np.array([math.sin(theta), 0.0, math.cos(theta)])
+        u = gen.random((n_samples, 2))
+        pick = gen.random(n_samples) < defensive
+        w = sample_cosine_hemisphere(u)
+        if has_sampler:
+            ws, _ = model.sample(np.broadcast_to(wi, (n_samples, 3)), u)
+            w = np.where(pick[:, None], w, ws)
+        wib = np.broadcast_to(wi, w.shape)
+        pdf = defensive * pdf_cosine_hemisphere(w)
+        if has_sampler:
+            pdf = pdf + (1.0 - defensive) * model.pdf(w, wib)
+        up = (w[:, 2] > 0.0) & (pdf > 0.0)
+        w_safe = np.where(up[:, None], w, np.array([0.0, 0.0, 1.0]))
+        f = np.asarray(model(wib, w_safe), dtype=np.float64).reshape(n_samples, -1)
+        est = np.where(up[:, None], f * (w_safe[:, 2] / np.where(up, pdf, 1.0))[:, None], 0.0)
+        vals_a.append(est.mean(axis=0))
+        vals_e.append(est.std(axis=0, ddof=1) / math.sqrt(n_samples))
+    a = np.array(vals_a)
+    e = np.array(vals_e)
+    spec = getattr(model, "specular_albedo", None)
+    if callable(spec):
+        a = a + np.asarray(spec(th.reshape(-1)), dtype=np.float64).reshape(a.shape[0], -1)
+    if getattr(model, "n_channels", None) is None and a.shape[1] == 1:
+        return AlbedoResult(th.copy(), a[:, 0].reshape(th.shape), e[:, 0].reshape(th.shape))
+    return AlbedoResult(th.copy(), a.reshape(th.shape + (-1,)), e.reshape(th.shape + (-1,)))
+
+
+# --------------------------------------------------------------------------- ρ_hh and H_s
+def hemispherical_albedo(model, *, n: int = 48, tol: float = 1e-7) -> tuple[np.ndarray,
+                                                                           np.ndarray]:
+    """Hemispherical–hemispherical albedo ρ_hh = (1/π) ∫ a(ω_i) cos θ_i dω_i.
+
+    With x = cos²θ_i, ρ_hh = ∫₀¹ a(θ_i(x)) dx; computed with n-point
+    Gauss–Legendre in x, and the n/2-point rule for the error estimate.
+
+    Returns
+    -------
+    (value, error) : ndarrays, scalars or (C,) for coloured models.
+    """
+    x, w = np.polynomial.legendre.leggauss(int(n))
+    x2, w2 = np.polynomial.legendre.leggauss(int(n) // 2)
+    xs = np.concatenate([(x + 1) / 2, (x2 + 1) / 2])
+    th = np.arccos(np.sqrt(xs))
+    th = np.minimum(th, math.pi / 2 - 1e-9)
+    r = albedo(model, th, tol=tol)
+    a = np.asarray(r.albedo)
+    v1 = np.tensordot(w / 2, a[: len(x)], axes=(0, 0))
+    v2 = np.tensordot(w2 / 2, a[len(x):], axes=(0, 0))
+    return v1, np.abs(v1 - v2) + np.tensordot(w / 2, np.asarray(r.error)[: len(x)], axes=(0, 0))
+
+
+@numba.njit(cache=True)
+def _fs_phong(ix, iy, iz, ox, oy, oz, p):
+    """Lewis eq. (5): F_s^P = max(0, R·V)^n (no 1/(N·S): H_s is the integral of F_s)."""
+    if iz <= 0.0 or oz <= 0.0:
+        return 0.0
+    rv = 2.0 * iz * oz - (ix * ox + iy * oy + iz * oz)
+    return rv ** p[0] if rv > 0.0 else (1.0 if p[0] == 0.0 else 0.0)
+
+
+@numba.njit(cache=True)
+def _fs_blinn(ix, iy, iz, ox, oy, oz, p):
+    """Lewis eq. (6): F_s^B = (N·H)^n."""
+    if iz <= 0.0 or oz <= 0.0:
+        return 0.0
+    hx = ix + ox
+    hy = iy + oy
+    hz = iz + oz
+    ln = math.sqrt(hx * hx + hy * hy + hz * hz)
+    if ln <= 1e-300:
+        return 0.0
+    return (hz / ln) ** p[0]
+
+
+class _SpecularIntegrand:
+    """Lewis's F_s as a kernel-carrying object for :func:`albedo` (not a registered model)."""
+
+    isotropic = True
+    n_channels = None
+
+    def __init__(self, n: float, lobe: str):
+        from brdfkit.halfangle import beta_from_exponent
+        from brdfkit.models import Lobe
+
+        self.kernel = _fs_phong if lobe == "phong" else _fs_blinn
+        self.packed = np.array([[float(n)]])
+        w = float(beta_from_exponent(n)) if n > 0 else math.pi / 2
+        self._lobes = [Lobe("mirror" if lobe == "phong" else "half", w)]
+
+    def lobes(self):
+        return self._lobes
+
+
+def H_s(theta_i, n: float, *, lobe: str = "phong", tol: float = 1e-8) -> AlbedoResult:
+    """Lewis's specular integral H_s(S) = ∫ F_s(S, V) (N·V) dω_V (§4.1, Fig. 5).
+
+    Parameters
+    ----------
+    theta_i : float or array_like
+        Incidence angle(s) of S, radians in [0, π/2).
+    n : float
+        Specular exponent n_s ≥ 0.
+    lobe : {"phong", "blinn"}, keyword-only
+        F_s^P = max(0, R·V)^n (eq. 5) or F_s^B = (N·H)^n (eq. 6).
+
+    Returns
+    -------
+    AlbedoResult
+        ``albedo`` holds H_s. Lewis eq. (19): k_ρ = k_d π + k_s H_s/(N·S).
+        At θ_i = 0 with the Phong lobe, H_s = 2π/(n + 2) (eq. 16 with γ = n + 1).
+    """
+    if lobe not in ("phong", "blinn"):
+        raise ParameterError(f"lobe must be 'phong' or 'blinn'; got {lobe!r}")
+    n = float(n)
+    if not (n >= 0.0 and math.isfinite(n)):
+        raise ParameterError(f"n must be a finite number >= 0; got {n!r}")
+    return albedo(_SpecularIntegrand(n, lobe), theta_i, tol=tol)
