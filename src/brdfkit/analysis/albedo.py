@@ -390,6 +390,31 @@ def _eval_kernel(kernel, P, thetas, offsets, wo, vals):  # pragma: no cover - co
                 vals[j, ch] = v if math.isfinite(v) else 0.0  # guard: never propagate NaN
 
 
+@numba.njit(parallel=True)
+def _eval_pairs_uncached(kernel, wi, wo, P, out):  # pragma: no cover - compiled
+    """Like :func:`brdfkit.models.eval_pairs`, but never cached (see :func:`_eval_kernel`)."""
+    for j in numba.prange(wi.shape[0]):
+        for ch in range(P.shape[0]):
+            v = kernel(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2], P[ch])
+            out[j, ch] = v if math.isfinite(v) else 0.0
+
+
+def evaluate_pairs(model, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
+    """f_r(wi, wo) for (N, 3) arrays → (N, C) (C = 1 for scalar models).
+
+    Compiled models run their kernel directly; anything else is called.
+    """
+    wi = np.ascontiguousarray(np.broadcast_to(wi, np.broadcast_shapes(wi.shape, wo.shape)),
+                              dtype=np.float64)
+    wo = np.ascontiguousarray(np.broadcast_to(wo, wi.shape), dtype=np.float64)
+    if _is_compiled(model):
+        P = np.ascontiguousarray(np.asarray(model.packed, dtype=np.float64))
+        out = np.empty((wi.shape[0], P.shape[0]))
+        _eval_pairs_uncached(model.kernel, wi, wo, P, out)
+        return out
+    return np.asarray(model(wi, wo), dtype=np.float64).reshape(wi.shape[0], -1)
+
+
 def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool, tol: float,
                n_channels: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Level loop shared by the compiled and the callable paths.
@@ -650,7 +675,7 @@ def albedo_mc(model, theta_i, *, n_samples: int = 100_000, rng=None,
             pdf = pdf + (1.0 - defensive) * model.pdf(w, wib)
         up = (w[:, 2] > 0.0) & (pdf > 0.0)
         w_safe = np.where(up[:, None], w, np.array([0.0, 0.0, 1.0]))
-        f = np.asarray(model(wib, w_safe), dtype=np.float64).reshape(n_samples, -1)
+        f = evaluate_pairs(model, wib, w_safe)
         est = np.where(up[:, None], f * (w_safe[:, 2] / np.where(up, pdf, 1.0))[:, None], 0.0)
         vals_a.append(est.mean(axis=0))
         vals_e.append(est.std(axis=0, ddof=1) / math.sqrt(n_samples))
