@@ -391,7 +391,14 @@ class BRDF:
         wi2 = np.ascontiguousarray(wi.reshape(-1, 3))
         wo2 = np.ascontiguousarray(wo.reshape(-1, 3))
         out = np.empty((wi2.shape[0], self._packed.shape[0]))
-        eval_pairs(self.kernel, wi2, wo2, self._packed, out)
+        try:
+            eval_pairs(self.kernel, wi2, wo2, self._packed, out)
+        except ReferenceError:
+            # Numba re-pickles eval_pairs' whole cache index when it saves a new kernel's
+            # specialisation; index entries written by another process refer to dispatchers
+            # that are dead here, so the save fails AFTER the compiled code was added in
+            # memory. The second call dispatches to it (the entry is just not cached on disk).
+            eval_pairs(self.kernel, wi2, wo2, self._packed, out)
         if self.n_channels is None:
             return out[:, 0].reshape(shape)
         return out.reshape(*shape, self.n_channels)
