@@ -375,10 +375,12 @@ def _reduce_all(vals, wk, wg, piece, offsets, npieces, out_a, out_e):
 # Not cached: Numba cannot reliably cache functions that take another compiled
 # function as an argument (the cache index pickles the dispatcher's type, and
 # loading it in a later process fails with "underlying object has vanished").
-@numba.njit(parallel=True)
+# Serial: compiles in ~0.3 s per model instead of ~1 s (this matters for
+# Table 2, which compiles it for every registered model).
+@numba.njit
 def _eval_kernel(kernel, P, thetas, offsets, wo, vals):  # pragma: no cover - compiled
     """vals[j, c] = kernel(ω_i(θ of j), wo[j], P[c]); NaN/inf replaced by 0."""
-    for i in numba.prange(thetas.shape[0]):
+    for i in range(thetas.shape[0]):
         ix = math.sin(thetas[i])
         iz = math.cos(thetas[i])
         for j in range(offsets[i], offsets[i + 1]):
@@ -390,10 +392,10 @@ def _eval_kernel(kernel, P, thetas, offsets, wo, vals):  # pragma: no cover - co
                 vals[j, ch] = v if math.isfinite(v) else 0.0  # guard: never propagate NaN
 
 
-@numba.njit(parallel=True)
+@numba.njit
 def _eval_pairs_uncached(kernel, wi, wo, P, out):  # pragma: no cover - compiled
     """Like :func:`brdfkit.models.eval_pairs`, but never cached (see :func:`_eval_kernel`)."""
-    for j in numba.prange(wi.shape[0]):
+    for j in range(wi.shape[0]):
         for ch in range(P.shape[0]):
             v = kernel(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2], P[ch])
             out[j, ch] = v if math.isfinite(v) else 0.0

@@ -1,0 +1,245 @@
+"""
+Physical plausibility verdicts
+==============================
+
+:func:`check` decides, by computation, whether a model is reciprocal and
+whether it conserves energy (Lewis §4–5, Neumann §2):
+
+- **Reciprocity** — the largest relative asymmetry
+  |f(L,V) − f(V,L)| / max(f(L,V), f(V,L)) over a structured set of pairs
+  (θ ∈ {0, 15, 30, 45, 60, 75, 85, 89, 89.9}°, both directions, five relative
+  azimuths including the mirror configuration). Reciprocal when ≤ 1e-6.
+- **Energy** — the albedo a(θ_i) on 0…87° in 3° steps plus
+  89°, 89.5°, 89.9°, 89.99°, 89.999°, refined about its maximum.
+  *diverges*: a grows without bound as θ_i → 90°; the rate p of
+  a ∝ (cos θ_i)^−p is the log–log slope between 89.99° and 89.999°, and the
+  verdict needs a positive slope (> 0.05) over the last two decades and an
+  increasing sequence a(89°) < a(89.9°) < a(89.99°) < a(89.999°) — the
+  asymptotics, not one value. Otherwise *conserves* if max a ≤ 1 (+1e-6
+  numerical slack) or *exceeds*, with ``max_scale`` = 1/max a, the largest
+  factor on the model's reflectance that makes it conserve (Lewis §4.2's b_j).
+- **Other objections** detected numerically: radiance that always peaks at
+  the normal (Lewis §3.3–3.4 against Neumann–Neumann and Minnaert), albedo
+  that collapses at grazing incidence (Neumann §1.2, the "dark Phong mirror").
+
+Public objects
+--------------
+- :class:`Verdict` — the result (``to_dict`` gives the JSON of
+  ``brdfkit check --json``).
+- :func:`check` — compute the verdict of a model.
+- :func:`divergence_rate` — slopes of log a against log cos θ_i near 90°.
+
+References
+----------
+- [Lewis1993] eqs. (15), (19), (23), §4.2 (b_j bound), Table 2.
+- [Neumann1999] §1.2, §2.1 eqs. (8)–(15).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from brdfkit.analysis.albedo import albedo, evaluate_pairs
+
+__all__ = ["Verdict", "check", "divergence_rate", "GRAZING_DEG", "RECIPROCITY_TOL"]
+
+RECIPROCITY_TOL = 1e-6
+CONSERVE_SLACK = 1e-6
+GRAZING_DEG = (89.0, 89.9, 89.99, 89.999)
+_PAIR_THETA_DEG = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 85.0, 89.0, 89.9)
+_PAIR_DPHI_DEG = (0.0, 45.0, 90.0, 135.0, 180.0)
+
+
+@dataclass
+class Verdict:
+    """Plausibility verdict of one model (see the module docstring for the rules)."""
+
+    model: str
+    params: dict
+    reciprocal: bool
+    max_asymmetry: float
+    energy: str
+    max_albedo: float
+    theta_max_deg: float
+    divergence_exponent: float | None
+    max_scale: float | None
+    notes: list[str] = field(default_factory=list)
+    grazing: dict = field(default_factory=dict)
+    slopes: list = field(default_factory=list)
+    peaks_at_normal: bool = False
+    albedo_error: float = 0.0
+
+    def to_dict(self) -> dict:
+        """JSON-ready dict with the keys of ``brdfkit check --json``."""
+        return {
+            "model": self.model,
+            "params": self.params,
+            "reciprocal": bool(self.reciprocal),
+            "max_asymmetry": float(self.max_asymmetry),
+            "energy": self.energy,
+            "max_albedo": float(self.max_albedo),
+            "theta_max_deg": float(self.theta_max_deg),
+            "divergence_exponent": (None if self.divergence_exponent is None
+                                    else float(self.divergence_exponent)),
+            "max_scale": None if self.max_scale is None else float(self.max_scale),
+            "notes": list(self.notes),
+            "grazing_albedo": {f"{k:g}": v for k, v in self.grazing.items()},
+            "grazing_slopes": [float(s) for s in self.slopes],
+            "peaks_at_normal": bool(self.peaks_at_normal),
+            "albedo_error": float(self.albedo_error),
+        }
+
+
+def _dirs(theta_deg, phi_deg) -> np.ndarray:
+    t = np.radians(theta_deg)
+    p = np.radians(phi_deg)
+    return np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], axis=-1)
+
+
+def reciprocity(model) -> float:
+    """Largest relative asymmetry |f(L,V) − f(V,L)| / max(f(L,V), f(V,L)) over the pair set."""
+    ti, to, dp = np.meshgrid(_PAIR_THETA_DEG, _PAIR_THETA_DEG, _PAIR_DPHI_DEG, indexing="ij")
+    L = _dirs(ti.ravel(), np.zeros(ti.size))
+    V = _dirs(to.ravel(), dp.ravel())
+    a = evaluate_pairs(model, L, V)
+    b = evaluate_pairs(model, V, L)
+    scale = max(float(np.max(np.abs(a))), float(np.max(np.abs(b))), 1e-300)
+    # floor: pairs where both values are ~1e-12 of the largest are rounding noise
+    den = np.maximum(np.maximum(np.abs(a), np.abs(b)), 1e-12 * scale)
+    return float(np.max(np.abs(a - b) / den))
+
+
+def divergence_rate(values: np.ndarray, theta_deg=GRAZING_DEG) -> list[float]:
+    """Slopes p_k = −Δ ln a / Δ ln cos θ_i between successive grazing angles (nan if a ≤ 0)."""
+    v = np.asarray(values, dtype=np.float64)
+    lc = np.log(np.cos(np.radians(np.asarray(theta_deg))))
+    out = []
+    for k in range(len(v) - 1):
+        if v[k] > 0.0 and v[k + 1] > 0.0:
+            out.append(float(-(math.log(v[k + 1]) - math.log(v[k])) / (lc[k + 1] - lc[k])))
+        else:
+            out.append(float("nan"))
+    return out
+
+
+def _peaks_at_normal(model) -> bool:
+    """True when, for θ_i = 30°, 60°, 80°, f(L, V) over V in the plane of incidence peaks at V = N.
+
+    f is scanned over signed θ_o ∈ [−89°, 89°] in 0.5° steps (positive = the
+    mirror side). A flat f (Lambert) does not count as a peak.
+    """
+    so = np.arange(-89.0, 89.0001, 0.5)
+    for ti in (30.0, 60.0, 80.0):
+        L = _dirs(np.full(so.size, ti), np.zeros(so.size))
+        V = _dirs(np.abs(so), np.where(so >= 0.0, 180.0, 0.0))
+        f = evaluate_pairs(model, L, V)
+        for ch in range(f.shape[1]):
+            col = f[:, ch]
+            if not np.all(np.isfinite(col)) or col.max() <= 0.0:
+                return False
+            if col.max() - col.min() <= 1e-9 * col.max():
+                return False  # flat: no peak anywhere
+            if abs(so[int(np.argmax(col))]) > 0.25:
+                return False
+    return True
+
+
+def check(model, *, tol: float = 1e-7) -> Verdict:
+    """Reciprocity and energy verdict of *model*, computed (see the module docstring).
+
+    Parameters
+    ----------
+    model : BRDF
+        A brdfkit model (or any object with ``eval``/``__call__``, ``lobes``).
+    tol : float, keyword-only
+        Albedo accuracy goal.
+
+    Returns
+    -------
+    Verdict
+    """
+    d = model.to_dict() if hasattr(model, "to_dict") else {"model": type(model).__name__,
+                                                           "params": {}}
+    asym = reciprocity(model)
+    grid = np.concatenate([np.arange(0.0, 87.01, 3.0), [89.0, 89.5], GRAZING_DEG[1:]])
+    r = albedo(model, np.radians(grid), tol=tol)
+    a = np.asarray(r.albedo).reshape(grid.size, -1)
+    err = float(np.max(np.asarray(r.error)))
+    notes: list[str] = []
+
+    # --- divergence from the asymptotics, per channel
+    ig = [int(np.argmin(np.abs(grid - g))) for g in GRAZING_DEG]
+    p_est = None
+    slopes_worst: list[float] = []
+    for ch in range(a.shape[1]):
+        seq = a[ig, ch]
+        sl = divergence_rate(seq)
+        increasing = bool(np.all(np.diff(seq) > 0.0))
+        if increasing and np.all(np.isfinite(sl[-2:])) and min(sl[-2:]) > 0.05:
+            if p_est is None or sl[-1] > p_est:
+                p_est = sl[-1]
+                slopes_worst = sl
+    if not slopes_worst:
+        ch_max = int(np.argmax(a.max(axis=0)))
+        slopes_worst = divergence_rate(a[ig, ch_max])
+
+    # --- maximum, refined about the grid maximum (bounded models)
+    flat_max = a.max(axis=1)
+    k = int(np.argmax(flat_max))
+    theta_max = float(grid[k])
+    max_a = float(flat_max[k])
+    if p_est is None and 0 < k < grid.size - 1 and grid[k] < 89.0:
+        lo, hi = grid[k - 1], grid[k + 1]
+        fine = np.linspace(lo, hi, 13)
+        rf = np.asarray(albedo(model, np.radians(fine), tol=tol).albedo).reshape(fine.size, -1)
+        kf = int(np.argmax(rf.max(axis=1)))
+        if rf.max(axis=1)[kf] > max_a:
+            max_a = float(rf.max(axis=1)[kf])
+            theta_max = float(fine[kf])
+
+    if p_est is not None:
+        energy = "diverges"
+        max_scale = None
+        p_rounded = float(round(p_est, 3))
+        notes.append(
+            f"albedo diverges at grazing incidence: a ∝ (cos θ_i)^-{p_rounded:g} "
+            f"(log-log slopes {', '.join(f'{s:.3f}' for s in slopes_worst)} over "
+            f"{', '.join(f'{g:g}' for g in GRAZING_DEG)} deg); a({GRAZING_DEG[-1]:g} deg) = "
+            f"{max_a:.4g}")
+    else:
+        p_rounded = None
+        if max_a <= 1.0 + max(CONSERVE_SLACK, 10 * err):
+            energy = "conserves"
+            max_scale = None
+        else:
+            energy = "exceeds"
+            max_scale = 1.0 / max_a
+            notes.append(f"bounded but exceeds 1: max albedo {max_a:.6g} at {theta_max:g} deg; "
+                         f"scale the reflectance by <= {max_scale:.6g} to conserve energy "
+                         "(Lewis §4.2 b_j bound)")
+
+    # --- other objections
+    peaks = _peaks_at_normal(model)
+    if peaks:
+        notes.append("reflected radiance always peaks at the normal (theta_r = 0) for every "
+                     "incidence tested (Lewis §3.3-3.4 objection)")
+    if energy != "diverges" and max_a > 0.0:
+        a_graze = float(a[ig[1]].max())
+        if a_graze < 0.5 * max_a:
+            notes.append(f"dark at grazing incidence: a(89.9 deg) = {a_graze:.3g}, "
+                         f"{100 * a_graze / max_a:.0f}% of its maximum (Neumann §1.2)")
+    if not asym <= RECIPROCITY_TOL:
+        notes.append(f"not reciprocal: max relative asymmetry {asym:.3g}")
+    if hasattr(model, "specular_albedo"):
+        notes.append("includes the energy of the specular delta term (specular_albedo)")
+
+    grazing = {g: float(a[i].max()) for g, i in zip(GRAZING_DEG, ig, strict=True)}
+    return Verdict(
+        model=d["model"], params=d["params"], reciprocal=bool(asym <= RECIPROCITY_TOL),
+        max_asymmetry=asym, energy=energy, max_albedo=max_a, theta_max_deg=theta_max,
+        divergence_exponent=p_rounded, max_scale=max_scale, notes=notes, grazing=grazing,
+        slopes=slopes_worst, peaks_at_normal=peaks, albedo_error=err,
+    )
