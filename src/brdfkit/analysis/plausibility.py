@@ -71,6 +71,8 @@ class Verdict:
     slopes: list = field(default_factory=list)
     peaks_at_normal: bool = False
     albedo_error: float = 0.0
+    min_albedo: float = 0.0
+    theta_min_deg: float = 0.0
 
     def to_dict(self) -> dict:
         """JSON-ready dict with the keys of ``brdfkit check --json``."""
@@ -90,6 +92,8 @@ class Verdict:
             "grazing_slopes": [float(s) for s in self.slopes],
             "peaks_at_normal": bool(self.peaks_at_normal),
             "albedo_error": float(self.albedo_error),
+            "min_albedo": float(self.min_albedo),
+            "theta_min_deg": float(self.theta_min_deg),
         }
 
 
@@ -236,10 +240,12 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
     if hasattr(model, "specular_albedo"):
         notes.append("includes the energy of the specular delta term (specular_albedo)")
 
+    kmin = int(np.argmin(a.min(axis=1)[grid <= 89.0]))
     grazing = {g: float(a[i].max()) for g, i in zip(GRAZING_DEG, ig, strict=True)}
     return Verdict(
         model=d["model"], params=d["params"], reciprocal=bool(asym <= RECIPROCITY_TOL),
         max_asymmetry=asym, energy=energy, max_albedo=max_a, theta_max_deg=theta_max,
         divergence_exponent=p_rounded, max_scale=max_scale, notes=notes, grazing=grazing,
         slopes=slopes_worst, peaks_at_normal=peaks, albedo_error=err,
+        min_albedo=float(a.min(axis=1)[kmin]), theta_min_deg=float(grid[kmin]),
     )
