@@ -141,3 +141,4 @@ def eval_cmd(model: str, param: tuple[str, ...], pump: str | None, times: int, w
 
 # --------------------------------------------------------------------------- more commands
 # Modules that add commands to `main` are imported here (after `main` exists).
+from brdfkit.cli import analysis as _analysis  # noqa: E402,F401  (albedo, check, table2, figure)
