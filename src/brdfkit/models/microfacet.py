@@ -85,6 +85,9 @@ def smith_g1_beckmann(cos_v: float, cos_vh: float, alpha: float) -> float:
     if sin_v == 0.0:
         return 1.0  # tan θ = 0: no masking at normal incidence
     a = cos_v / (alpha * sin_v)
+    if a < 1e-150:
+        # grazing: G₁ = 2a√π (1 + O(a)); also avoids 1/0 when a underflows to 0
+        return 2.0 * a * SQRT_PI
     return 2.0 / (1.0 + math.erf(a) + math.exp(-a * a) / (a * SQRT_PI))
 
 
@@ -668,6 +671,10 @@ def htsg_shadow(cos_t: float, sigma0: float, tau: float) -> float:
     if sin_t == 0.0:
         return 1.0  # normal direction: no shadowing
     a = tau * cos_t / (2.0 * sigma0 * sin_t)
+    if a < 1e-8:
+        # grazing: Λ = 1/(2a√π) − ½ + O(a), so S = a√π (1 + O(a)); also avoids 1/0 when a
+        # underflows to 0
+        return a * SQRT_PI
     erfc_a = math.erfc(a)
     lam = 0.5 * (math.exp(-a * a) / (a * SQRT_PI) - erfc_a)
     return (1.0 - 0.5 * erfc_a) / (lam + 1.0)
@@ -767,13 +774,20 @@ def _he_torrance(ix, iy, iz, ox, oy, oz, p):
     two_pi = 2.0 * math.pi
     g = (two_pi * sigma * sz) ** 2
     a = tau * tau * (two_pi * two_pi) * (sx * sx + sy * sy) / 4.0  # τ² v_xy²/4
-    d = 0.25 * math.pi * math.pi * tau * tau * htsg_series(g, a)
-    geo = (vv / sz) ** 2  # G = (v·v/v_z)², the polarisation sums reduce to this
-    shadow = htsg_shadow(iz, sigma0, tau) * htsg_shadow(oz, sigma0, tau)
+    # G D with G = (v·v/v_z)² (the polarisation sums reduce to this). G overflows when v_z
+    # is tiny while D vanishes like g ∝ v_z²; for g < 1e-100 the first term of the series
+    # alone is exact to 1e-100 and the product is written out: G·g = (v·v)² (2πσ)².
+    if g < 1e-100:
+        geo_d = vv * vv * (two_pi * sigma) ** 2 * math.exp(-a - g)
+    else:
+        geo_d = (vv / sz) ** 2 * htsg_series(g, a)
+    geo_d *= 0.25 * math.pi * math.pi * tau * tau  # D = (π²τ²/4) Σ ...
+    # S(θ)/cos θ stays finite at the horizon (S ≈ a√π ∝ cos θ there), so divide per direction.
+    s_i = htsg_shadow(iz, sigma0, tau) / iz
+    s_r = htsg_shadow(oz, sigma0, tau) / oz
     cos_d = math.sqrt(vv) * 0.5  # wi·h = |wi + wo|/2, the local (bisector) angle
     f = 1.0 if eta == 0.0 else _fresnel_conductor(cos_d, eta, kappa)  # eta not given: F = 1
-    dd = f * geo * shadow * d / (math.pi * max(iz * oz, DENOM_FLOOR))  # floor: see DENOM_FLOOR
-    return dd + rho_d * INV_PI
+    return f * geo_d * s_i * s_r * INV_PI + rho_d * INV_PI
 
 
 @numba.njit(cache=True)
