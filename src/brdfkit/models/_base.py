@@ -179,7 +179,11 @@ def _fmt(x: float) -> str:
     return f"{x:g}"
 
 
-@numba.njit(parallel=True, cache=True)
+# Not cached on disk: a specialisation is keyed on the kernel's dispatcher, which is new
+# in every process, so an on-disk entry could never be reused (and Numba fails to re-save
+# an index holding dead dispatchers). The kernels themselves are cached; compiling this
+# loop around one costs ~0.5-1 s once per process and model.
+@numba.njit(parallel=True)
 def eval_pairs(kernel, wi, wo, P, out):  # pragma: no cover - compiled
     """out[j, c] = kernel(wi[j], wo[j], P[c]) for all pairs j and channels c.
 
@@ -391,14 +395,7 @@ class BRDF:
         wi2 = np.ascontiguousarray(wi.reshape(-1, 3))
         wo2 = np.ascontiguousarray(wo.reshape(-1, 3))
         out = np.empty((wi2.shape[0], self._packed.shape[0]))
-        try:
-            eval_pairs(self.kernel, wi2, wo2, self._packed, out)
-        except ReferenceError:
-            # Numba re-pickles eval_pairs' whole cache index when it saves a new kernel's
-            # specialisation; index entries written by another process refer to dispatchers
-            # that are dead here, so the save fails AFTER the compiled code was added in
-            # memory. The second call dispatches to it (the entry is just not cached on disk).
-            eval_pairs(self.kernel, wi2, wo2, self._packed, out)
+        eval_pairs(self.kernel, wi2, wo2, self._packed, out)
         if self.n_channels is None:
             return out[:, 0].reshape(shape)
         return out.reshape(*shape, self.n_channels)
