@@ -696,8 +696,9 @@ def hemispherical_albedo(model, *, n: int = 48, tol: float = 1e-7) -> tuple[np.n
                                                                            np.ndarray]:
     """Hemispherical–hemispherical albedo ρ_hh = (1/π) ∫ a(ω_i) cos θ_i dω_i.
 
-    With x = cos²θ_i, ρ_hh = ∫₀¹ a(θ_i(x)) dx; computed with n-point
-    Gauss–Legendre in x, and the n/2-point rule for the error estimate.
+    With μ = cos θ_i = u², ρ_hh = ∫₀¹ a(μ) 2μ dμ = ∫₀¹ 4 a(u²) u³ du, computed with
+    n-point Gauss–Legendre in u (smooth even when a ∝ μ^−p near grazing), and the
+    n/2-point rule for the error estimate.
 
     Returns
     -------
@@ -705,14 +706,18 @@ def hemispherical_albedo(model, *, n: int = 48, tol: float = 1e-7) -> tuple[np.n
     """
     x, w = np.polynomial.legendre.leggauss(int(n))
     x2, w2 = np.polynomial.legendre.leggauss(int(n) // 2)
-    xs = np.concatenate([(x + 1) / 2, (x2 + 1) / 2])
-    th = np.arccos(np.sqrt(xs))
-    th = np.minimum(th, math.pi / 2 - 1e-9)
+    us = np.concatenate([(x + 1) / 2, (x2 + 1) / 2])
+    th = np.arccos(np.clip(us * us, 0.0, 1.0))
+    th = np.minimum(th, math.pi / 2 - 1e-12)  # the node nearest grazing stays inside [0, π/2)
     r = albedo(model, th, tol=tol)
     a = np.asarray(r.albedo)
-    v1 = np.tensordot(w / 2, a[: len(x)], axes=(0, 0))
-    v2 = np.tensordot(w2 / 2, a[len(x):], axes=(0, 0))
-    return v1, np.abs(v1 - v2) + np.tensordot(w / 2, np.asarray(r.error)[: len(x)], axes=(0, 0))
+    wt = 4.0 * us ** 3
+    wt = wt.reshape(wt.shape + (1,) * (a.ndim - 1))
+    aw = a * wt
+    v1 = np.tensordot(w / 2, aw[: len(x)], axes=(0, 0))
+    v2 = np.tensordot(w2 / 2, aw[len(x):], axes=(0, 0))
+    ew = np.asarray(r.error)[: len(x)] * wt[: len(x)]
+    return v1, np.abs(v1 - v2) + np.tensordot(w / 2, ew, axes=(0, 0))
 
 
 @numba.njit(cache=True)
