@@ -72,7 +72,8 @@ def test_beckmann_m_definition(beta):
     m = ha.beckmann_m_from_beta(beta)
     assert d4(math.cos(beta), m) / d4(1.0, m) == pytest.approx(0.5, rel=1e-10)
     # Lewis's printed m = tan b / sqrt(ln 2 - 4 ln cos b) (§3.2) agrees with the definition.
-    assert m == pytest.approx(math.tan(beta) / math.sqrt(math.log(2) - 4 * math.log(math.cos(beta))))
+    printed = math.tan(beta) / math.sqrt(math.log(2) - 4 * math.log(math.cos(beta)))
+    assert m == pytest.approx(printed)
 
 
 def test_beckmann_peak_caveat():
@@ -104,7 +105,9 @@ def test_neumann_neumann_printed_formula_is_wrong(beta):
     assert f(math.cos(beta), s) / f(1.0, s) == pytest.approx(0.5, rel=1e-9)
 
 
-@pytest.mark.parametrize("name,scale", [("minnaert", "b_M"), ("minnaert-energy-conserving", "k_rho")])
+@pytest.mark.parametrize(
+    "name,scale", [("minnaert", "b_M"), ("minnaert-energy-conserving", "k_rho")]
+)
 @pytest.mark.parametrize("beta", BETAS)
 def test_minnaert_k_definition_with_model(name, scale, beta):
     model = brdfkit.model(name, **{scale: 0.5}, beta=beta)
@@ -184,3 +187,22 @@ def test_inverse_domains():
         ha.beta_from_gaussian_c(0.5)
     with pytest.raises(ParameterError, match="'beta'"):
         brdfkit.model("neumann-neumann", beta=0.3, s=1.0)
+
+
+@pytest.mark.parametrize("distribution", ["beckmann", "ggx"])
+@pytest.mark.parametrize("beta", [0.02, 0.3, 0.9])
+def test_microfacet_beta_definition(distribution, beta):
+    # D(beta) = D(0)/2 for Walter's normalised NDFs (normalisation cancels in the ratio).
+    from brdfkit.models.microfacet import d_beckmann, d_ggx
+
+    d = {"beckmann": d_beckmann, "ggx": d_ggx}[distribution]
+    model = brdfkit.model("microfacet", distribution=distribution, beta=beta)
+    alpha = model.values["alpha"]
+    assert d(math.cos(beta), alpha) / d(1.0, alpha) == pytest.approx(0.5, rel=1e-10)
+
+
+def test_with_params_beta_follows_distribution():
+    m = brdfkit.model("torrance-sparrow", distribution="phong", n=10.0).with_params(beta=0.2)
+    assert m.values["n"] == pytest.approx(ha.exponent_from_beta(0.2))
+    d = brdfkit.MODELS["torrance-sparrow"].describe()
+    assert "phong" in d["beta"] and "beckmann" in d["beta"]

@@ -43,7 +43,10 @@ def variant():
     return mi
 
 
-def directions(rng, n, max_theta=math.radians(88.0)):
+MAX_THETA = math.radians(88.0)
+
+
+def directions(rng, n, max_theta=MAX_THETA):
     # cos θ uniform in [cos max, 1]: uniform on the cap of the hemisphere
     z = rng.uniform(math.cos(max_theta), 1.0, n)
     phi = rng.uniform(0.0, 2 * math.pi, n)

@@ -431,8 +431,8 @@ def test_colour_broadcasting():
     eta = [1.3, 1.5, 1.7]
     col = brdfkit.model("torrance-sparrow", eta=eta).eval(wi, wo)
     for c, e in enumerate(eta):
-        np.testing.assert_allclose(col[..., c], brdfkit.model("torrance-sparrow", eta=e).eval(wi, wo),
-                                   rtol=1e-14)
+        grey = brdfkit.model("torrance-sparrow", eta=e).eval(wi, wo)
+        np.testing.assert_allclose(col[..., c], grey, rtol=1e-14)
     w = brdfkit.model("ward", rho_d=[0.1, 0.2], rho_s=[0.3, 0.4]).eval(wi, wo)
     assert w.shape == (2, 3, 2)
 

@@ -141,6 +141,10 @@ class Microfacet(BRDF):
     rho_s         1           [0, 1]        specular scale (per channel)
     ============  ==========  ============  ==========================================
 
+    ``beta`` (half-angle, radians) sets α so that D(β) = D(0)/2
+    (:func:`~brdfkit.halfangle.beckmann_m_from_beta` for Beckmann,
+    :func:`~brdfkit.halfangle.trowbridge_reitz_c_from_beta` for GGX).
+
     Reciprocal. Energy: bounded by 1 with F ≤ 1 (only single scattering, so
     rough surfaces lose energy). Sampled by the distribution of normals
     D(h) cos θ_h (Walter eqs. 28, 35), pdf D cos θ_h / (4 |ω_o·h|).
@@ -162,6 +166,7 @@ class Microfacet(BRDF):
     citation = "Walter et al. 2007, eq. (20) with (25)-(27) Beckmann, (33)-(34) GGX"
     reciprocal = True
     has_sampler = True
+    width_param = "alpha"
     kernel = _microfacet
     examples = (
         {},
@@ -169,6 +174,23 @@ class Microfacet(BRDF):
         {"distribution": "ggx", "alpha": 0.5, "eta": [0.2, 0.9, 1.1], "k": [3.9, 2.4, 2.2]},
         {"alpha": 1.0, "eta": 1.5},
     )
+
+    @classmethod
+    def width_from_beta(cls, beta: float) -> float:
+        """α of the default (Beckmann) distribution; GGX is handled per instance."""
+        return beckmann_m_from_beta(beta)
+
+    def __init__(self, **values):
+        beta = values.pop("beta", None)
+        if beta is not None:
+            if "alpha" in values:
+                raise ParameterError(f"{self.name}: give either 'beta' or 'alpha', not both")
+            dist = values.get("distribution", "beckmann")
+            # D(β) = D(0)/2: Beckmann is Lewis's D₄ shape (α = m), GGX is Lewis's D₃ (α = c₃).
+            conv = trowbridge_reitz_c_from_beta if str(dist).lower() == "ggx" \
+                else beckmann_m_from_beta
+            values["alpha"] = conv(_check_beta(self.name, beta))
+        super().__init__(**values)
 
     def lobes(self):
         return [Lobe("half", float(self._values["alpha"]))]
@@ -851,6 +873,13 @@ class HeTorrance(_HalfVectorSampling, BRDF):
     - The series of D is truncated with a rigorous tail bound at relative
       error 1e-12.
     - The uniform-diffuse term a(λ) is a free constant ρ_d, as in HTSG.
+
+    With Neumann's Fig. 1 parameters (σ₀ = 0.1, τ = 1.7, F = 1) the
+    directional-diffuse albedo falls from ≈ 0.80 at θ_i = 0 to ≈ 0.11 at 80°,
+    the "bad decrease" Neumann et al. describe, while the specular delta
+    rises from e^{−(0.4π)²} ≈ 0.21 toward 1, so that their sum stays close to
+    1 — the albedo curve of Neumann Fig. 1 is consistent with the
+    directional-diffuse part only.
 
     In the geometric-optics limit (g ≫ 1) the series tends to e^{−tan²δ/m²}/g
     with m = 2σ/τ and ρ_dd tends to the Cook–Torrance form
