@@ -50,7 +50,7 @@ import numba
 import numpy as np
 
 from brdfkit._array import as_directions, as_uniform, stack
-from brdfkit._kern import INV_PI, INV_TWO_PI, below_horizon, half, n_dot_h, pos_pow, r_dot_v
+from brdfkit._kern import INV_PI, INV_TWO_PI, below_horizon, n_dot_h, pos_pow, r_dot_v
 from brdfkit.errors import ParameterError
 from brdfkit.fresnel import _fresnel_dielectric
 from brdfkit.geometry import (
@@ -226,7 +226,7 @@ def blinn_normal_albedo(n):
 
     n = 0 gives π (the cosine integral, Lewis eq. 16); for large n it tends to
     8π/n. Nielsen eq. (2)'s factor (n+8)/8π (Akenine-Möller et al.) is an
-    approximation of its reciprocal.
+    approximation of its reciprocal, too large by up to 7.5 % (n ≈ 8.76).
     """
     n = np.asarray(n, dtype=np.float64)
     a = -np.expm1(-0.5 * (n + 4.0) * math.log(2.0)) / (n + 4.0)
@@ -892,11 +892,13 @@ class ModifiedBlinnPhong(_MixtureSampled):
 
         ∫ (N·H)ⁿ cos θ_o dω_o = 8π [2(1 − 2^{−(n+4)/2})/(n+4) − (1 − 2^{−(n+2)/2})/(n+2)],
 
-    so the specular albedo at normal incidence is ρ_s·(n+8)/(8π)·that: exactly
-    ρ_s at n = 0, 0.875 ρ_s at n = 4 (the minimum over n ≥ 0 is ≈ 0.86 at
-    n ≈ 3), 1.061 ρ_s at n = 20 (the maximum, ≈ 1.06, near n ≈ 20), and
-    ≈ (1 + 2/n) ρ_s for large n (1.0020 at n = 1000). Hence ρ_s ≤ 1 does
-    not quite guarantee energy conservation.
+    so the specular albedo at normal incidence is ρ_s·(n+8)/(8π)·that, which is
+    ≥ ρ_s for every n ≥ 0: exactly ρ_s at n = 0, 1.0243 ρ_s at n = 1, 1.0625 ρ_s
+    at n = 4, a maximum of 1.0752 ρ_s at n ≈ 8.76, 1.0607 ρ_s at n = 20,
+    1.0181 ρ_s at n = 100 and ≈ (1 + 2/n) ρ_s for large n (the exact factor,
+    1/that integral, tends to (n+2)(n+4)/(8πn) ≈ (n+6)/8π). The approximation thus
+    over-estimates the albedo by up to 7.5 %: ρ_d + ρ_s ≤ 1 does not quite
+    guarantee energy conservation.
 
     ======  =======  ===========  =============================================
     name    default  bounds       meaning
@@ -1099,14 +1101,15 @@ class NeumannPhong(_MixtureSampled):
     The paper states that c_n ≤ (n+2)/2π "must hold in order for the model to
     preserve energy balance"; ``c_n=None`` (default) takes that value. The
     bound is NECESSARY (at normal incidence the albedo is c_n 2π/(n+2), Lewis
-    eq. 16) but NOT SUFFICIENT: at oblique incidence the albedo with
-    c_n = (n+2)/2π exceeds 1 — for n = 0 it is exactly 2 − cos θ_i (split the
-    hemisphere at cos θ_o = cos θ_i: 2π(1 − cos θ_i) + π cos θ_i, times 1/π),
-    and for large n the lobe about R is nearly uncut at moderate θ_i with
-    cos θ_o / max(cos θ_i, cos θ_o) ≈ 1, so the albedo approaches
-    c_n 2π/(n+1) = (n+2)/(n+1). A sufficient bound is c_n ≤ (n+1)/2π, since
-    cos θ_o / max(·) ≤ 1 and ∫ max(0, R·V)ⁿ dω ≤ 2π/(n+1). Values above
-    either bound are accepted (so that analyses can show the violation).
+    eq. 16). It is SUFFICIENT only for exponents that are not small: with
+    c_n = (n+2)/2π the albedo peaks at normal incidence for n ≳ 0.75
+    (numerically; e.g. n = 1, 20, 100), but for smaller n it exceeds 1 at
+    oblique incidence — at n = 0 (0⁰ = 1) it is exactly 2 − cos θ_i (split
+    the hemisphere at cos θ_o = cos θ_i: [2π(1 − cos θ_i) + π cos θ_i]/π),
+    and at n = 0.1 it reaches ≈ 1.06 at θ_i = 45°. A bound sufficient for all
+    n is c_n ≤ (n+1)/2π, because cos θ_o/max(cos θ_i, cos θ_o) ≤ 1 and
+    ∫ max(0, R·V)ⁿ dω ≤ 2π/(n+1). Values above either bound are accepted, so
+    that analyses can show the violation.
 
     ======  =======  ===========  =============================================
     name    default  bounds       meaning
@@ -1165,10 +1168,17 @@ def _nielsen(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
     rho_d, k_s, s, alpha, eta = p[0], p[1], p[2], p[3], p[4]
-    hx, hy, hz, _ = half(ix, iy, iz, ox, oy, oz)
-    f = 1.0 if eta == 0.0 else _fresnel_dielectric(ix * hx + iy * hy + iz * hz, eta)
+    # One square root, one division: ω_h·n = (N·L + N·V)/|L + V|,
+    # ω_i·ω_h = (1 + L·V)/|L + V| = |L + V|/2 and ω_r·ω_o = 2(N·L)(N·V) − L·V.
+    # |L + V| comes from the components (not √(2 + 2 L·V), which rounds to 0 for
+    # grazing opposite directions).
+    lv = ix * ox + iy * oy + iz * oz
+    sx, sy, sz = ix + ox, iy + oy, iz + oz
+    length = math.sqrt(sx * sx + sy * sy + sz * sz)  # ≥ sz > 0 above the horizon
+    hz = sz / length
+    f = 1.0 if eta == 0.0 else _fresnel_dielectric(0.5 * length, eta)  # no eta: F = 1
     hz2 = hz * hz
-    base = (1.0 - alpha) * r_dot_v(ix, iy, iz, ox, oy, oz) + alpha * hz2 * hz2
+    base = (1.0 - alpha) * (2.0 * iz * oz - lv) + alpha * hz2 * hz2
     # clamp the mixed base at 0 (pos_pow): R·V < 0 away from the mirror direction can make
     # it negative, where a non-integer power is undefined and the Phong lobe of eq. (1)
     # is 0 (max(0, ·), as in Akenine-Möller et al.)
