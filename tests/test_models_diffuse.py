@@ -141,6 +141,26 @@ def test_minnaert_pdf_normalised(k):
     assert 2 * math.pi * val == pytest.approx(1.0, rel=1e-9)
 
 
+@pytest.mark.parametrize("s", [0.0, 0.3, 5.0, 200.0])
+def test_neumann_neumann_sampler(s, rng):
+    # Draws from (s+2)/(2π) cos^{s+1}; the weights f cos/pdf are bounded by their value at
+    # cos θ_i = 1 (see the docstring), and their mean is the closed-form albedo.
+    model = brdfkit.model("neumann-neumann", b_N=0.3, s=s)
+    wo = spherical_to_cartesian(0.5, 1.0)
+    wi, pdf = model.sample(wo, rng.random((200_000, 2)))
+    np.testing.assert_allclose(pdf, model.pdf(wi, wo), rtol=1e-12)
+    se_ref = np.std(wi[:, 2]) / math.sqrt(len(wi))
+    assert abs(np.mean(wi[:, 2]) - (s + 2) / (s + 3)) < 5 * se_ref + 1e-12  # E[cos] closed form
+    ok = pdf > 0
+    w = np.where(ok, model.eval(wi, wo) * wi[:, 2] / np.where(ok, pdf, 1.0), 0.0)
+    w_max = float(model.eval(NORMAL, wo)) * 2 * math.pi / (s + 2)
+    assert np.max(w) <= w_max * (1 + 1e-12)
+    expected = 2 * math.pi * 0.3 * math.exp(2 * s - s / math.cos(0.5)) * special.expn(3, s) \
+        if s > 0 else 0.3 * math.pi
+    se = np.std(w) / math.sqrt(len(w))
+    assert abs(np.mean(w) - expected) < 5 * se + 1e-12
+
+
 # ----------------------------------------------------------------------------- common physics
 SEPARABLE = [
     ("neumann-neumann", {"b_N": 0.3, "s": 0.8}),

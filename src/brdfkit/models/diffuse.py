@@ -110,7 +110,12 @@ class NeumannNeumann(BRDF):
 
     The β conversion printed by Lewis §3.3, s = −ln 2/(1 + cos β), is wrong
     (negative); see :func:`brdfkit.halfangle.neumann_s_from_beta`.
-    No lobe sampler: the cosine fallback is used.
+
+    Sampling: f cos θ_i ∝ μ e^{−s/μ} (μ = cos θ_i) has no invertible CDF, so
+    wi is drawn from the density (s+2)/(2π) μ^{s+1} (inverse CDF
+    μ = u₀^{1/(s+2)}), which dominates it: the weight f cos θ_i/pdf is
+    proportional to exp{−s(1/μ − 1 + ln μ)} ≤ 1 (the exponent is ≥ 0 on
+    (0, 1]), so the estimator's weights are bounded by their value at μ = 1.
     """
 
     name = "neumann-neumann"
@@ -122,7 +127,7 @@ class NeumannNeumann(BRDF):
     )
     citation = "Lewis 1993 §3.3 (after Neumann & Neumann 1989)"
     reciprocal = True
-    has_sampler = False
+    has_sampler = True
     width_param = "s"
     kernel = _neumann_neumann
     examples = (
@@ -138,6 +143,12 @@ class NeumannNeumann(BRDF):
     def lobes(self):
         s = float(self._values["s"])
         return [Lobe("normal", beta_from_neumann_s(s) if s > 0.0 else math.pi / 2)]
+
+    def sample(self, wo, u):
+        return _sample_cos_power(self, float(self._values["s"]) + 1.0, wo, u)
+
+    def pdf(self, wi, wo):
+        return _pdf_cos_power(float(self._values["s"]) + 1.0, wi, wo)
 
 
 # --------------------------------------------------------------------------- Minnaert
@@ -174,16 +185,11 @@ def _minnaert_ec(ix, iy, iz, ox, oy, oz, p):
     return k_rho * (k + 1.0) * INV_TWO_PI * _minnaert_core(iz, oz, k)
 
 
-def _sample_minnaert(model, wo, u):
-    """wi with density (k+1)/(2π) cos^k θ_i: cos θ = u₀^{1/(k+1)} (inverse CDF).
-
-    f cos θ_i is proportional to cos^k θ_i for fixed wo, so this is exact
-    importance sampling: f cos θ_i / pdf does not depend on wi.
-    """
+def _sample_cos_power(model, q, wo, u):
+    """wi with density (q+1)/(2π) cos^q θ_i (q > −1): cos θ = u₀^{1/(q+1)} (inverse CDF)."""
     wo = as_directions(wo, "wo")
     u = as_uniform(u)
-    k = float(model._values["k"])
-    cos_t = u[..., 0] ** (1.0 / (k + 1.0))
+    cos_t = u[..., 0] ** (1.0 / (q + 1.0))
     sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))  # clamp: rounding at cos_t = 1
     phi = 2.0 * np.pi * u[..., 1]
     wi = stack(sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t)
@@ -191,15 +197,28 @@ def _sample_minnaert(model, wo, u):
     return wi, model.pdf(wi, wo)
 
 
-def _pdf_minnaert(model, wi, wo):
+def _pdf_cos_power(q, wi, wo):
+    """Density of :func:`_sample_cos_power`; 0 below the horizon or when wo is below it."""
     wi = as_directions(wi, "wi")
     wo = as_directions(wo, "wo")
-    k = float(model._values["k"])
-    c = np.maximum(wi[..., 2], 0.0)
+    c = wi[..., 2]
     with np.errstate(divide="ignore"):
-        p = (k + 1.0) / (2.0 * np.pi) * np.where(c > 0.0, c, 0.0) ** k
+        p = (q + 1.0) / (2.0 * np.pi) * np.where(c > 0.0, c, 1.0) ** q
     p = np.where(c > 0.0, p, 0.0)
     return np.where(wo[..., 2] > 0.0, p, 0.0)
+
+
+def _sample_minnaert(model, wo, u):
+    """Exact importance sampling of Minnaert: f cos θ_i ∝ cos^k θ_i for fixed wo.
+
+    So wi is drawn with density (k+1)/(2π) cos^k θ_i and f cos θ_i / pdf does
+    not depend on wi.
+    """
+    return _sample_cos_power(model, float(model._values["k"]), wo, u)
+
+
+def _pdf_minnaert(model, wi, wo):
+    return _pdf_cos_power(float(model._values["k"]), wi, wo)
 
 
 def _minnaert_lobes(k: float) -> list:
