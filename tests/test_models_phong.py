@@ -51,7 +51,7 @@ def albedo(m, theta_i, *, width=0.2, sub=2):
            *[k * width for k in (0.5, 1.0, 2.0, 4.0, 8.0) if k * width < math.pi]}
     brk = np.array(sorted(brk))
     edges = np.unique(np.concatenate([np.linspace(a, b, sub + 1)
-                                      for a, b in zip(brk[:-1], brk[1:])]))
+                                      for a, b in zip(brk[:-1], brk[1:], strict=True)]))
     a0, a1 = edges[:-1, None], edges[1:, None]
     al = (0.5 * (a1 - a0) * (X64 + 1.0) + a0).ravel()
     wa = (0.5 * (a1 - a0) * W64).ravel()
@@ -83,7 +83,7 @@ def normal_incidence_albedo(m, n):
         v = np.stack([np.sin(t), np.zeros_like(t), np.cos(t)], axis=-1)
         return m.eval(np.array([0.0, 0.0, 1.0]), v) * np.cos(t) * np.sin(t)
     return 2.0 * math.pi * sum(integrate.fixed_quad(g, a, b, n=64)[0]
-                               for a, b in zip(brk[:-1], brk[1:]))
+                               for a, b in zip(brk[:-1], brk[1:], strict=True))
 
 
 def h_s_reference(theta_i, n, lobe):
