@@ -232,3 +232,25 @@ def test_to_jsonable_nan_and_numpy():
                        "d": (np.inf,), "e": np.bool_(True)})
     assert out == {"a": [1.0, None], "b": 2.0, "c": 3, "d": [None], "e": True}
     json.dumps(out, allow_nan=False)
+
+
+# --------------------------------------------------------------------------- README
+def test_readme_model_table_is_current():
+    # The README's model table is generated from the registry; regenerate it with
+    # `.venv/bin/python scripts/model_table.py --write` after adding a model.
+    root = pathlib.Path(__file__).resolve().parent.parent
+    readme = (root / "README.md").read_text()
+    block = readme.split("<!-- models:start -->", 1)[1].split("<!-- models:end -->", 1)[0]
+    listed = [line.split("`")[1] for line in block.splitlines() if line.startswith("| `")]
+    assert listed == list(brdfkit.MODELS), "run scripts/model_table.py --write"
+
+
+def test_readme_commands_are_marked():
+    # .ci/run executes the block after <!-- cmd:test -->; the main job follows <!-- cmd:main -->.
+    root = pathlib.Path(__file__).resolve().parent.parent
+    readme = (root / "README.md").read_text()
+    for marker, needle in (("<!-- cmd:main -->", "bash scripts/setup.sh && .venv/bin/brdfkit "),
+                           ("<!-- cmd:test -->", "bash scripts/setup.sh --test && ")):
+        after = readme.split(marker, 1)[1].lstrip()
+        assert after.startswith("```bash\n"), marker
+        assert after.split("\n")[1].startswith(needle), after.split("\n")[1]
