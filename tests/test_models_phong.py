@@ -278,8 +278,9 @@ def test_neumann_phong_bound_is_necessary_not_sufficient():
         return float(m0.eval(direction(t_i), direction(t, 1.0))) * math.cos(t) * math.sin(t)
     a0 = 2.0 * math.pi * integrate.quad(g, 0.0, 0.5 * math.pi, points=[t_i], epsrel=1e-12)[0]
     assert a0 == pytest.approx(2.0 - math.cos(t_i), rel=1e-10)
-    # and for a small positive exponent the paper's c_n still gives albedo > 1 at 45°
+    # and for small positive exponents the paper's c_n still gives albedo > 1 off the normal
     assert albedo(brdfkit.model("neumann-phong", n=0.1), math.radians(45.0), width=1.0) > 1.05
+    assert albedo(brdfkit.model("neumann-phong", n=1.0), math.radians(13.0), width=0.7) > 1.0002
     # the bound sufficient for every n, c_n = (n+1)/2π, keeps it below 1
     m_ok = brdfkit.model("neumann-phong", n=0.1, c_n=1.1 / (2.0 * math.pi))
     assert albedo(m_ok, math.radians(45.0), width=1.0) < 1.0

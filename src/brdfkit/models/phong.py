@@ -1125,11 +1125,12 @@ class NeumannPhong(_MixtureSampled):
     preserve energy balance"; ``c_n=None`` (default) takes that value. The
     bound is NECESSARY (at normal incidence the albedo is c_n 2π/(n+2), Lewis
     eq. 16). It is SUFFICIENT only for exponents that are not small: with
-    c_n = (n+2)/2π the albedo peaks at normal incidence for n ≳ 0.75
-    (numerically; e.g. n = 1, 20, 100), but for smaller n it exceeds 1 at
-    oblique incidence — at n = 0 (0⁰ = 1) it is exactly 2 − cos θ_i (split
-    the hemisphere at cos θ_o = cos θ_i: [2π(1 − cos θ_i) + π cos θ_i]/π),
-    and at n = 0.1 it reaches ≈ 1.06 at θ_i = 45°. A bound sufficient for all
+    c_n = (n+2)/2π the albedo peaks at normal incidence for n ≳ 1.7
+    (numerically; e.g. n = 2, 5, 50, 1000), but for smaller n it exceeds 1 at
+    oblique incidence — slightly at n = 1 (1.00029 at θ_i ≈ 13°), more at
+    n = 0.1 (≈ 1.06 at θ_i = 45°), and at n = 0 (0⁰ = 1) it is exactly
+    2 − cos θ_i (split the hemisphere at cos θ_o = cos θ_i:
+    [2π(1 − cos θ_i) + π cos θ_i]/π). A bound sufficient for all
     n is c_n ≤ (n+1)/2π, because cos θ_o/max(cos θ_i, cos θ_o) ≤ 1 and
     ∫ max(0, R·V)ⁿ dω ≤ 2π/(n+1). Values above either bound are accepted, so
     that analyses can show the violation.
