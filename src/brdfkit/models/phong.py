@@ -399,7 +399,9 @@ def specular_integral(theta_i, n: float, lobe: str = "phong") -> np.ndarray:
 # near the normal, where H_s has terms in θ_i^{n+2} (non-smooth in cos θ_i for small
 # non-even n). Cubic Lagrange interpolation in v then reaches ~1e-9 relative for all n.
 def _table_size(n: float) -> int:
-    return int(min(4096, max(512, math.ceil(1024.0 * (max(n, 1.0) / 600.0) ** 0.25))))
+    # interpolation error ~ n/size⁴ near grazing; small n need nodes near the normal
+    size = math.ceil(1024.0 * (max(n, 1.0) / 600.0) ** 0.25)
+    return int(min(4096, max(2048 if n < 2.0 else 512, size)))
 
 
 @functools.lru_cache(maxsize=64)
@@ -700,7 +702,7 @@ class PhongEnergyConserving(_MixtureSampled):
     (dense near grazing, where the horizon cuts a sharp lobe; linear in θ_i
     near the normal, where H_s has θ_i^{n+2} terms) and interpolated by cubic
     Lagrange polynomials in the kernel (relative error ≲ 1e-8 for n ≤ 1e6,
-    ~1e-11 for n ≤ 1000). At θ_i = 90° H_s is positive (e.g. B((n+1)/2, 3/2)
+    ≲ 1e-9 for n ≤ 1e5). At θ_i = 90° H_s is positive (e.g. B((n+1)/2, 3/2)
     for Phong), so the kernel is finite there.
 
     =======  =======  ============  ===========================================
