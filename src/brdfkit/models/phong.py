@@ -20,7 +20,7 @@ Public objects
 - :class:`NeumannPhong` — ``neumann-phong``: Neumann eq. (22).
 - :class:`Nielsen` — ``nielsen``: Nielsen eq. (3) with Fresnel.
 - :func:`specular_integral` — Lewis's H_s(S) for the Phong or Blinn lobe, by
-  quadrature in the lobe frame (relative accuracy ~1e-12).
+  quadrature in the lobe frame (relative accuracy ~1e-11).
 - :func:`lobe_pow` — max(0, x)ⁿ with 0⁰ = 1, binary exponentiation for integral n.
 - :func:`blinn_normal_albedo` — ∫(N·H)ⁿ cos θ_o dω_o at normal incidence, closed form.
 - :func:`sample_phong_lobe`, :func:`pdf_phong_lobe`, :func:`sample_blinn_lobe`,
@@ -374,7 +374,7 @@ def specular_integral(theta_i, n: float, lobe: str = "phong") -> np.ndarray:
     ndarray
         H_s(θ_i) (sr). Computed in the lobe frame with the azimuthal integral
         in closed form and a tanh-sinh rule over the polar angle where the
-        horizon cuts the lobe; relative accuracy ~1e-12 for n ≤ 1e6. Checks:
+        horizon cuts the lobe; relative accuracy ~1e-11 for n ≤ 1e6. Checks:
         H_s(0) = 2π/(n+2) (Phong, Lewis eq. 16); H_s(π/2) = B((n+1)/2, 3/2)
         (Phong), 8π/((n+2)(n+4)) (Blinn); Blinn at n = 0 is π at every θ_i.
     """
@@ -698,7 +698,7 @@ class PhongEnergyConserving(_MixtureSampled):
 
     H_s depends on θ_i and n only. It is computed once per (n, lobe) by
     quadrature in the lobe frame (:func:`specular_integral`, relative accuracy
-    ~1e-12), tabulated at 512–4096 nodes uniform in v = √(1 − √(1 − cos θ_i))
+    ~1e-11), tabulated at 512–4096 nodes uniform in v = √(1 − √(1 − cos θ_i))
     (dense near grazing, where the horizon cuts a sharp lobe; linear in θ_i
     near the normal, where H_s has θ_i^{n+2} terms) and interpolated by cubic
     Lagrange polynomials in the kernel (relative error ≲ 1e-8 for n ≤ 1e6,
