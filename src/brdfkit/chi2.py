@@ -290,6 +290,8 @@ class Chi2Result:
         Per-test significance level used (after the Šidák correction).
     pdf_integral : float
         ∫ pdf over the binned region (the upper hemisphere unless ``lower="bins"``).
+    pdf_integral_sphere : float
+        ∫ pdf over the whole sphere (a quadrature estimate; must be ≤ 1).
     n_samples, n_valid : int
         Samples drawn; samples with pdf > 0 (histogrammed).
     message : str
@@ -304,6 +306,7 @@ class Chi2Result:
     dof: int
     alpha: float
     pdf_integral: float
+    pdf_integral_sphere: float
     n_samples: int
     n_valid: int
     message: str = ""
@@ -489,6 +492,20 @@ def chi2_test(model, wo, *, n_samples: int = 200_000, seed=0, alpha: float = 0.0
     elif total > 1.0 + 1e-3:
         fail.append(f"pdf integrates to {total:.6f} > 1 over {region}")
 
+    # the whole sphere too (coarser tolerance: a microfacet pdf's 1/ε point at wi = −wo makes
+    # this quadrature less accurate; it is a sanity bound, the χ² cells above are exact)
+    if lower == "pool":
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            full, _ = binning.integrate(lambda w: model.pdf(w, np.broadcast_to(wo, w.shape)),
+                                        max_depth=4)
+        sphere_total = float(np.sum(full))
+        if not np.isfinite(sphere_total):
+            fail.append("pdf is not finite somewhere on the sphere")
+        elif sphere_total > 1.0 + 1e-2:
+            fail.append(f"pdf integrates to {sphere_total:.4f} > 1 over the sphere")
+    else:
+        sphere_total = total
+
     expected = probs * n_samples
     # one more cell: samples not binned (discarded, or below the horizon with lower="pool")
     # against the mass of the pdf outside the binned region
@@ -510,7 +527,8 @@ def chi2_test(model, wo, *, n_samples: int = 200_000, seed=0, alpha: float = 0.0
 
     return Chi2Result(
         passed=not fail, p_value=p_value, statistic=stat, dof=dof, alpha=level,
-        pdf_integral=total, n_samples=n_samples, n_valid=int(np.count_nonzero(valid)),
+        pdf_integral=total, pdf_integral_sphere=sphere_total, n_samples=n_samples,
+        n_valid=int(np.count_nonzero(valid)),
         message="; ".join(fail), unresolved_cells=unresolved, observed=observed,
         expected=expected,
     )
