@@ -93,3 +93,4 @@ def save_figure(name: str, path: str, *, dpi: int = 150) -> str:
 
 # Importing the figure modules registers their figures.
 from brdfkit.figures import lewis, neumann  # noqa: E402,F401,I001
+from brdfkit.figures import pumping as _pumping_figures  # noqa: E402,F401  (neumann-fig3 ... fig7)
