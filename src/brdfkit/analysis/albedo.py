@@ -111,6 +111,15 @@ def _t_max(mode, theta):
     return 0.5 * math.pi
 
 
+@numba.njit(cache=True, inline="always")
+def _k2_cos(t, s, c):
+    """cos φ on the V-groove kink 2(N·H)(N·V) = V·H at half-vector polar angle t (4cos²t > 1)."""
+    ct = math.cos(t)
+    st = math.sin(t)
+    d = 2.0 * ct * c / (4.0 * ct * ct - 1.0)
+    return (d - c * ct) / (s * st)
+
+
 @numba.njit(cache=True)
 def _t_breaks(mode, theta, width, out):
     """Sorted break points of the t axis (including 0 and t_max); returns their count."""
@@ -124,12 +133,42 @@ def _t_breaks(mode, theta, width, out):
     n += 1
     if mode == MIRROR:
         cand[n] = e  # circle about R first touches the horizon
-        n += 1
+        cand[n + 1] = 0.5 * math.pi  # R·V = 0: the max(0, R·V) clamp of Phong-type lobes
+        cand[n + 2] = 2.0 * theta  # the curve N·V = N·L (max(N·L, N·V) models) meets φ = 0
+        n += 3
     elif mode == HALF:
         cand[n] = 0.5 * e  # the half-vector circle first maps below the horizon
         cand[n + 1] = e  # V-groove kink 2(N·H)(N·L) = L·H reaches φ = 0
         cand[n + 2] = theta  # V-groove kink N·V = N·L reaches φ = 0
-        n += 3
+        cand[n + 3] = 0.25 * math.pi  # the three V-groove kink curves cross (2cos²t = 1)
+        n += 4
+        # V-groove kink 2(N·H)(N·V) = V·H reaches φ = 0 or π: roots of k₂(t) = ±1
+        s_ = math.sin(theta)
+        c_ = math.cos(theta)
+        if s_ <= 1e-12:
+            cand[n] = math.pi / 6.0  # normal incidence: the kink is the circle 4cos²t = 3
+            n += 1
+        else:
+            m_scan = 256
+            t_hi = math.pi / 3.0 - 1e-9  # k₂ exists where 4 cos²t > 1
+            prev_t = 1e-9
+            prev = _k2_cos(prev_t, s_, c_)
+            for j in range(1, m_scan + 1):
+                t = 1e-9 + (t_hi - 1e-9) * j / m_scan
+                cur = _k2_cos(t, s_, c_)
+                for target in (-1.0, 1.0):
+                    if (prev - target) * (cur - target) < 0.0 and n < 40:
+                        lo, hi = prev_t, t
+                        for _ in range(60):
+                            mid = 0.5 * (lo + hi)
+                            if (_k2_cos(lo, s_, c_) - target) * (_k2_cos(mid, s_, c_) - target) <= 0.0:
+                                hi = mid
+                            else:
+                                lo = mid
+                        cand[n] = 0.5 * (lo + hi)
+                        n += 1
+                prev = cur
+                prev_t = t
     w = max(min(width, 0.5 * math.pi), 1e-9)
     b = w
     while b < tmax and n < 60:
@@ -155,7 +194,7 @@ def _t_breaks(mode, theta, width, out):
 
 
 @numba.njit(cache=True)
-def _phi_breaks(mode, t, s, c, out):
+def _phi_breaks(mode, t, s, c, level, out, nvnl=False):
     """Break points 0 = b₀ < … < b_k = φ_max of the azimuth at polar angle t; returns k + 1.
 
     φ_max is where ω_o meets the horizon (closed form). In half-vector mode
@@ -188,6 +227,16 @@ def _phi_breaks(mode, t, s, c, out):
             phimax = math.acos(c0)
     out[0] = 0.0
     k = 1
+    if mode == MIRROR and (level >= 1 or nvnl) and s * st > 1e-300 and phimax > 0.0:
+        # N·V = N·L: c cos t + s sin t cos φ = c ⇔ cos φ = (c/s) tan(t/2); kink of
+        # max(N·L, N·V) denominators (Neumann eq. 22). Only from the first refinement
+        # on: most mirror-lobe models are smooth there, and level 0 is the fast path.
+        cp = c * (1.0 - ct) / (s * st)
+        if -1.0 < cp < 1.0:
+            ph = math.acos(cp)
+            if 1e-12 < ph < phimax - 1e-12:
+                out[k] = ph
+                k += 1
     if mode == HALF and s * st > 1e-300 and phimax > 0.0:
         dstar = np.empty(3)
         nd = 0
@@ -253,13 +302,13 @@ def _count_nodes(mode, theta, width, level, sym):
     tb = np.empty(64)
     nt = _t_breaks(mode, theta, width, tb)
     sub = 1 << level
-    n_int = 5 if mode == HALF else 1
+    n_int = 5 if mode == HALF else 2
     halves = 1 if sym else 2
     return (nt - 1) * sub * 15 * n_int * sub * 15 * halves, (nt - 1) * sub * halves
 
 
 @numba.njit(cache=True)
-def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece):
+def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, nvnl=False):
     """Fill the nodes of one incidence angle; returns the number written.
 
     wo (N, 3), wk / wg (N,) Kronrod / Gauss weights including the measure and
@@ -270,7 +319,7 @@ def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece):
     tb = np.empty(64)
     nt = _t_breaks(mode, theta, width, tb)
     sub = 1 << level
-    n_int = 5 if mode == HALF else 1
+    n_int = 5 if mode == HALF else 2
     halves = 1 if sym else 2
     fac = 2.0 if sym else 1.0
     pb = np.empty(8)
@@ -284,18 +333,16 @@ def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece):
                 t = a + (b - a) * X[it]
                 wtk = WK[it] * (b - a)
                 wtg = WG[it] * (b - a)
-                k = _phi_breaks(mode, t, s, c, pb)
+                k = _phi_breaks(mode, t, s, c, level, pb, nvnl)
                 st = math.sin(t)
                 ct = math.cos(t)
                 for h in range(halves):
                     sign = 1.0 if h == 0 else -1.0
                     for j in range(n_int):
-                        if j < k - 1:
-                            pa = pb[j]
-                            pz = pb[j + 1]
-                        else:
-                            pa = 0.0
-                            pz = 0.0
+                        if j >= k - 1:
+                            break  # no more azimuth intervals at this t: write no nodes
+                        pa = pb[j]
+                        pz = pb[j + 1]
                         for r in range(sub):
                             fa = pa + (pz - pa) * r / sub
                             fb = pa + (pz - pa) * (r + 1) / sub
@@ -342,22 +389,26 @@ def _reduce(vals, wk, wg, piece, n_pieces, n, C, out_a, out_e):
                 # its factor 200^1.5, which overestimates by ~1e5 here; see the tests
                 # against closed forms) and never more than |K − G| itself.
                 r = d / A[p, ch]
-                err += min(d, A[p, ch] * r * math.sqrt(r))
+                # ... but at least 2% of |K − G|: a kink inside a panel (a clamp the
+                # break points do not know about) makes the Kronrod rule only a little
+                # better than the Gauss rule
+                err += min(d, max(A[p, ch] * r * math.sqrt(r), 0.02 * d))
         out_a[ch] = tot
         out_e[ch] = err + 1e-15 * abs(tot)  # floor: rounding of the sum
 
 
-def _gen_all_py(mode, thetas, width, levels, sym, X, WK, WG, offsets, wo, wk, wg, piece):
+def _gen_all_py(mode, thetas, width, levels, sym, X, WK, WG, offsets, wo, wk, wg, piece,
+                nvnl):
     """Nodes of every angle i at its level, written at offsets[i] (parallel over angles)."""
     for i in numba.prange(thetas.shape[0]):
         o = offsets[i]
         m = offsets[i + 1] - o
         n = _gen_nodes(mode, thetas[i], width, levels[i], sym, X, WK, WG, wo[o:o + m],
-                       wk[o:o + m], wg[o:o + m], piece[o:o + m])
-        for j in range(n, m):  # unused slots (none in practice): weight 0
+                       wk[o:o + m], wg[o:o + m], piece[o:o + m], nvnl)
+        for j in range(n, m):  # unused slots (absent azimuth intervals): weight 0
             wo[o + j, 0] = 0.0
             wo[o + j, 1] = 0.0
-            wo[o + j, 2] = 1.0
+            wo[o + j, 2] = 0.0  # z = 0: skipped by the evaluator, contributes 0
             wk[o + j] = 0.0
             wg[o + j] = 0.0
             piece[o + j] = 0
@@ -426,7 +477,7 @@ def evaluate_pairs(model, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
 
 
 def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool, tol: float,
-               n_channels: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+               n_channels: int, nvnl: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Level loop shared by the compiled and the callable paths.
 
     ``evaluate(thetas, offsets, wo) -> vals (N, C)`` evaluates f at the nodes.
@@ -452,7 +503,7 @@ def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool,
         piece = np.empty(total, dtype=np.int64)
         big = total >= PARALLEL_NODES
         gen = _gen_all_parallel if big else _gen_all_serial
-        gen(mode, th, width, lv, sym, _X, _WK, _WGAUSS, offsets, wo, wk, wg, piece)
+        gen(mode, th, width, lv, sym, _X, _WK, _WGAUSS, offsets, wo, wk, wg, piece, nvnl)
         vals = np.ascontiguousarray(evaluate(th, offsets, wo), dtype=np.float64)
         aa = np.empty((th.size, vals.shape[1]))
         ee = np.empty_like(aa)
@@ -508,6 +559,17 @@ def lobe_frame(model) -> tuple[int, float]:
     if mode == NORMAL and ("mirror" in kinds or "half" in kinds):
         mode = _MODE[next(lb.kind for lb in lobes if lb.kind in ("mirror", "half"))]
     return mode, min(width, math.pi / 2)
+
+
+#: Registered models whose formula has a max(N·L, N·V) (Neumann et al. eq. 22): their
+#: kink N·V = N·L is a break point from the start. Other models can declare
+#: ``albedo_kinks = ("nv=nl",)``; any model gets it from the first refinement on.
+NVNL_KINK_MODELS = frozenset({"neumann-phong"})
+
+
+def _has_nvnl_kink(model) -> bool:
+    return getattr(model, "name", None) in NVNL_KINK_MODELS or \
+        "nv=nl" in tuple(getattr(model, "albedo_kinks", ()))
 
 
 def _check_theta(theta_i) -> np.ndarray:
@@ -595,7 +657,8 @@ def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
             _eval_kernel(kernel, P, th, offsets, wo, vals)
             return vals
 
-        a, e, _ = _integrate(evaluate, flat, m_mode, m_width, sym, tol, P.shape[0])
+        a, e, _ = _integrate(evaluate, flat, m_mode, m_width, sym, tol, P.shape[0],
+                             _has_nvnl_kink(model))
         coloured = getattr(model, "n_channels", None) is not None
     elif callable(model):
         a, e, coloured = _albedo_callable(model, flat, m_mode, m_width, tol)
@@ -620,14 +683,17 @@ def _albedo_callable(f: Callable, flat: np.ndarray, mode: int, width: float, tol
 
     def evaluate(th, offsets, wo):
         idx = np.repeat(np.arange(th.size), np.diff(offsets))
-        wi = np.stack([np.sin(th[idx]), np.zeros(idx.size), np.cos(th[idx])], axis=-1)
-        vals = np.asarray(f(wi, wo), dtype=np.float64)
-        if vals.shape[:1] != (wo.shape[0],) or vals.ndim > 2:
-            raise BrdfkitError(f"albedo: the callable returned shape {vals.shape} for "
-                               f"{wo.shape[0]} direction pairs; expected (N,) or (N, C)")
-        shape_info["coloured"] = vals.ndim == 2
-        vals = np.where(np.isfinite(vals), vals, 0.0).reshape(wo.shape[0], -1)
-        return np.where((wo[:, 2] > 0.0)[:, None], vals, 0.0)
+        up = wo[:, 2] > 0.0  # unused slots and rounding below the horizon: not evaluated
+        wi = np.stack([np.sin(th[idx]), np.zeros(idx.size), np.cos(th[idx])], axis=-1)[up]
+        got = np.asarray(f(wi, np.ascontiguousarray(wo[up])), dtype=np.float64)
+        if got.shape[:1] != (wi.shape[0],) or got.ndim > 2:
+            raise BrdfkitError(f"albedo: the callable returned shape {got.shape} for "
+                               f"{wi.shape[0]} direction pairs; expected (N,) or (N, C)")
+        shape_info["coloured"] = got.ndim == 2
+        got = np.where(np.isfinite(got), got, 0.0).reshape(wi.shape[0], -1)
+        vals = np.zeros((wo.shape[0], got.shape[1]))
+        vals[up] = got
+        return vals
 
     probe = evaluate(np.array([0.0]), np.array([0, 1]), np.array([[0.0, 0.0, 1.0]]))
     a, e, _ = _integrate(evaluate, flat, mode, width, False, tol, probe.shape[1])
