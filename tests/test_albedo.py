@@ -71,7 +71,7 @@ def _phong_lobe_reference(theta: float, n: float) -> float:
     pts = sorted({e, width, 2 * width, 4 * width, 8 * width})
     total = 0.0
     edges = [0.0] + [p for p in pts if p < math.pi / 2] + [math.pi / 2]
-    for a, b in zip(edges[:-1], edges[1:]):
+    for a, b in zip(edges[:-1], edges[1:], strict=False):
         v, _ = integrate.quad(inner, a, b, epsabs=1e-14, epsrel=1e-13, limit=200)
         total += v
     return total
@@ -133,7 +133,7 @@ def _beckmann_reference(theta: float, alpha: float) -> float:
     edges = sorted({0.0, alpha, 2 * alpha, 4 * alpha, 8 * alpha, (math.pi / 2 - theta) / 2})
     edges = [x for x in edges if x < 10 * alpha] + [10 * alpha]
     total = 0.0
-    for a, b in zip(edges[:-1], edges[1:]):
+    for a, b in zip(edges[:-1], edges[1:], strict=False):
         v, _ = integrate.quad(outer, a, b, epsabs=1e-12, epsrel=1e-11, limit=100)
         total += v
     return total  # D < e^{-100} beyond t = 10 α

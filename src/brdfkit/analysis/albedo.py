@@ -161,7 +161,8 @@ def _t_breaks(mode, theta, width, out):
                         lo, hi = prev_t, t
                         for _ in range(60):
                             mid = 0.5 * (lo + hi)
-                            if (_k2_cos(lo, s_, c_) - target) * (_k2_cos(mid, s_, c_) - target) <= 0.0:
+                            f_lo = _k2_cos(lo, s_, c_) - target
+                            if f_lo * (_k2_cos(mid, s_, c_) - target) <= 0.0:
                                 hi = mid
                             else:
                                 lo = mid
