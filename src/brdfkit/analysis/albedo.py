@@ -299,16 +299,28 @@ def _direction(mode, st, ct, phi, s, c):
 
 
 @numba.njit(cache=True)
-def _count_nodes(mode, theta, width, level, sym):
+def _count_nodes(mode, theta, width, level, sym, X, nvnl=False):
+    """Exact number of nodes :func:`_gen_nodes` writes, and the number of error pieces."""
     tb = np.empty(64)
+    pb = np.empty(8)
     nt = _t_breaks(mode, theta, width, tb)
     sub = 1 << level
     n_int = 5 if mode == HALF else 2
     halves = 1 if sym else 2
-    return (nt - 1) * sub * 15 * n_int * sub * 15 * halves, (nt - 1) * sub * halves
+    s = math.sin(theta)
+    c = math.cos(theta)
+    n = 0
+    for ip in range(nt - 1):
+        for q in range(sub):
+            a = tb[ip] + (tb[ip + 1] - tb[ip]) * q / sub
+            b = tb[ip] + (tb[ip + 1] - tb[ip]) * (q + 1) / sub
+            for it in range(15):
+                k = _phi_breaks(mode, a + (b - a) * X[it], s, c, level, pb, nvnl)
+                n += min(k - 1, n_int) * sub * 15 * halves
+    return n, (nt - 1) * sub * halves
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract"})
 def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, nvnl=False):
     """Fill the nodes of one incidence angle; returns the number written.
 
@@ -425,7 +437,7 @@ def _reduce_all_py(vals, wk, wg, piece, offsets, npieces, out_a, out_e):
 
 # Serial and parallel builds: a parallel region costs a thread rendezvous, which on a
 # busy machine (or for ~1e5 nodes) is slower than doing the work on one core.
-_gen_all_serial = numba.njit(cache=True)(_gen_all_py)
+_gen_all_serial = numba.njit(cache=True, error_model="numpy")(_gen_all_py)
 _gen_all_parallel = numba.njit(cache=True, parallel=True)(_gen_all_py)
 _reduce_all_serial = numba.njit(cache=True)(_reduce_all_py)
 _reduce_all_parallel = numba.njit(cache=True, parallel=True)(_reduce_all_py)
@@ -494,7 +506,7 @@ def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool,
         counts = np.empty(th.size, dtype=np.int64)
         npieces = np.empty(th.size, dtype=np.int64)
         for k, t in enumerate(th):
-            counts[k], npieces[k] = _count_nodes(mode, float(t), width, level, sym)
+            counts[k], npieces[k] = _count_nodes(mode, float(t), width, level, sym, _X, nvnl)
         offsets = np.zeros(th.size + 1, dtype=np.int64)
         np.cumsum(counts, out=offsets[1:])
         total = int(offsets[-1])
