@@ -5,7 +5,8 @@ Analysis: albedo, plausibility verdicts and Lewis's Table 2
 Public objects
 --------------
 - :func:`albedo`, :class:`AlbedoResult` — deterministic directional albedo
-  with an error estimate (:mod:`brdfkit.analysis.albedo`).
+  with an error estimate (module :mod:`brdfkit.analysis.albedo`; note that
+  the package attribute ``brdfkit.analysis.albedo`` is the function).
 - :func:`albedo_mc` — importance-sampled Monte-Carlo albedo.
 - :func:`hemispherical_albedo` — ρ_hh.
 - :func:`H_s` — Lewis's specular integral (§4.1, Fig. 5).
@@ -13,15 +14,16 @@ Public objects
   (:mod:`brdfkit.analysis.plausibility`).
 - :func:`table2` — Lewis's Table 2 regenerated for every registered model
   (:mod:`brdfkit.analysis.table2`).
+
+References
+----------
+- [Lewis1993] eqs. (15)–(24), Figs. 5, 7–9, Table 2.
+- [Neumann1999] §1.2, §2.1, Fig. 1.
 """
 
 from brdfkit.analysis.albedo import AlbedoResult, H_s, albedo, albedo_mc, hemispherical_albedo
+from brdfkit.analysis.plausibility import Verdict, check
+from brdfkit.analysis.table2 import table2
 
-__all__ = ["AlbedoResult", "H_s", "albedo", "albedo_mc", "hemispherical_albedo"]
-
-try:  # the verdict modules import lazily-heavy parts; keep albedo importable on its own
-    from brdfkit.analysis.plausibility import Verdict, check  # noqa: F401
-
-    __all__ += ["Verdict", "check"]
-except ImportError:  # pragma: no cover - during development
-    pass
+__all__ = ["AlbedoResult", "H_s", "Verdict", "albedo", "albedo_mc", "check",
+           "hemispherical_albedo", "table2"]
