@@ -12,8 +12,11 @@ import numpy as np
 from brdfkit.errors import BrdfkitError
 
 
-def as_directions(v, name: str) -> np.ndarray:
+def as_directions(v, name: str, *, check_finite: bool = True) -> np.ndarray:
     """Return *v* as a float64 array of shape ``(..., 3)``; never mutates *v*.
+
+    ``check_finite=False`` skips the finiteness test, for callers that do it
+    themselves in the same pass as their computation (:meth:`BRDF.eval`).
 
     Raises
     ------
@@ -25,7 +28,7 @@ def as_directions(v, name: str) -> np.ndarray:
         raise BrdfkitError(
             f"{name} must be an array of unit vectors of shape (..., 3); got shape {a.shape}"
         )
-    if not np.all(np.isfinite(a)):
+    if check_finite and not np.all(np.isfinite(a)):
         raise BrdfkitError(f"{name} contains NaN or infinite components")
     return a
 

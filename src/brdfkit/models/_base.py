@@ -40,7 +40,7 @@ import numba
 import numpy as np
 
 from brdfkit._array import as_directions, as_uniform
-from brdfkit.errors import ParameterError
+from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.geometry import pdf_cosine_hemisphere, sample_cosine_hemisphere
 
 __all__ = ["Param", "Lobe", "BRDF", "eval_pairs"]
@@ -192,9 +192,58 @@ def eval_pairs(kernel, wi, wo, P, out):  # pragma: no cover - compiled
     """
     n = wi.shape[0]
     n_channels = P.shape[0]
-    for j in numba.prange(n):
-        for c in range(n_channels):
-            out[j, c] = kernel(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2], P[c])
+    if n_channels == 1:
+        # the common case, with the parameter row hoisted out of the loop
+        p = P[0]
+        for j in numba.prange(n):
+            out[j, 0] = kernel(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2], p)
+    else:
+        for j in numba.prange(n):
+            for c in range(n_channels):
+                out[j, c] = kernel(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2],
+                                   P[c])
+
+
+@numba.njit(inline="always")
+def _finite6(a, b, c, d, e, f) -> bool:
+    # x − x is 0 for finite x and NaN for ±inf and NaN; the sum is 0 iff all six are finite
+    return (a - a) + (b - b) + (c - c) + (d - d) + (e - e) + (f - f) == 0.0
+
+
+@numba.njit(parallel=True)
+def eval_pairs_checked(kernel, wi, wo, P, out):  # pragma: no cover - compiled
+    """:func:`eval_pairs` that also tests the directions for NaN/inf in the same pass.
+
+    Pairs with a non-finite component are not passed to the kernel (their
+    ``out`` rows are NaN). Returns the number of such pairs, so that the
+    caller can raise; reading the directions once instead of twice is what
+    makes this faster than ``np.isfinite`` followed by :func:`eval_pairs`.
+    """
+    n = wi.shape[0]
+    n_channels = P.shape[0]
+    n_bad = 0
+    if n_channels == 1:
+        p = P[0]
+        for j in numba.prange(n):
+            ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
+            ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
+            if _finite6(ix, iy, iz, ox, oy, oz):
+                out[j, 0] = kernel(ix, iy, iz, ox, oy, oz, p)
+            else:
+                out[j, 0] = math.nan
+                n_bad += 1
+    else:
+        for j in numba.prange(n):
+            ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
+            ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
+            if _finite6(ix, iy, iz, ox, oy, oz):
+                for c in range(n_channels):
+                    out[j, c] = kernel(ix, iy, iz, ox, oy, oz, P[c])
+            else:
+                for c in range(n_channels):
+                    out[j, c] = math.nan
+                n_bad += 1
+    return n_bad
 
 
 class BRDF:
@@ -385,8 +434,10 @@ class BRDF:
             0 below the horizon. A trailing channel axis when any colour
             parameter was given per channel.
         """
-        wi = as_directions(wi, "wi")
-        wo = as_directions(wo, "wo")
+        # finiteness is tested in the compiled pass (eval_pairs_checked): one read of the data
+        wi_in, wo_in = wi, wo
+        wi = as_directions(wi, "wi", check_finite=False)
+        wo = as_directions(wo, "wo", check_finite=False)
         shape = np.broadcast_shapes(wi.shape, wo.shape)[:-1]
         if wi.shape[:-1] != shape or not wi.flags.c_contiguous:
             wi = np.broadcast_to(wi, (*shape, 3))
@@ -395,7 +446,10 @@ class BRDF:
         wi2 = np.ascontiguousarray(wi.reshape(-1, 3))
         wo2 = np.ascontiguousarray(wo.reshape(-1, 3))
         out = np.empty((wi2.shape[0], self._packed.shape[0]))
-        eval_pairs(self.kernel, wi2, wo2, self._packed, out)
+        if eval_pairs_checked(self.kernel, wi2, wo2, self._packed, out):
+            as_directions(wi_in, "wi")  # raises the usual BrdfkitError for NaN/inf
+            as_directions(wo_in, "wo")
+            raise BrdfkitError("wi or wo contains NaN or infinite components")  # unreachable
         if self.n_channels is None:
             return out[:, 0].reshape(shape)
         return out.reshape(*shape, self.n_channels)
