@@ -22,7 +22,12 @@ The ratio column is brdfkit / Mitsuba for the comparable pairs: ``microfacet``
 vs ``roughconductor`` and ``modified-phong`` vs the Python-registered Phong.
 Before timing, the script checks that the compared implementations agree
 (relative difference of f_r·cos θ on 10⁵ pairs; Mitsuba is single precision
-and uses the rational fit of the Beckmann G₁, brdfkit the exact erf form).
+and uses the rational fit of the Beckmann G₁, brdfkit the exact erf form,
+tabulated to < 1e-13 relative).
+
+The machine's load average (``os.getloadavg``) is printed before and after
+the timings: the numbers are only comparable within one run, and only when
+the load is low. ``--threads 1`` gives single-thread costs (ns/eval column).
 
 Mitsuba's LLVM variants need Debian's ``libllvm19``
 (``apt-get update && apt-get install -y libllvm19``; LLVM 15/16 load but abort
@@ -204,6 +209,8 @@ def main(argv=None) -> int:
     ap.add_argument("--repeats", type=int, default=5, help="timed repetitions (median; >= 1)")
     ap.add_argument("--seed", type=int, default=12345)
     ap.add_argument("--no-mitsuba", action="store_true", help="skip the Mitsuba rows")
+    ap.add_argument("--threads", type=int, default=0,
+                    help="Numba threads for brdfkit (default: all); Mitsuba is not limited")
     args = ap.parse_args(argv)
     if args.pairs < 1000 or args.repeats < 1:
         ap.error("--pairs must be >= 1000 and --repeats >= 1")
@@ -212,8 +219,13 @@ def main(argv=None) -> int:
 
     import brdfkit
 
+    if args.threads < 0:
+        ap.error("--threads must be >= 0")
+    if args.threads:
+        numba.set_num_threads(args.threads)
     n = args.pairs
     wi, wo = random_pairs(n, args.seed)
+    print("load average (1, 5, 15 min): %.2f %.2f %.2f" % os.getloadavg())
     print(f"brdfkit {brdfkit.__version__}, NumPy {np.__version__}, Numba {numba.__version__} "
           f"({numba.get_num_threads()} threads), {os.cpu_count()} CPUs; {n:,} pairs, "
           f"median of {args.repeats} after a warm-up")
@@ -265,9 +277,9 @@ def main(argv=None) -> int:
         ("brdfkit", "modified-phong"): ("Mitsuba", "python-phong"),
     }
     print()
-    print(f"| {'implementation':<20} | {'model':<16} | {'M evals/s':>9} | {'time (s)':>8} | "
-          f"{'brdfkit/Mitsuba':>15} |")
-    print(f"|{'-' * 22}|{'-' * 18}|{'-' * 11}|{'-' * 10}|{'-' * 17}|")
+    print(f"| {'implementation':<20} | {'model':<16} | {'M evals/s':>9} | {'ns/eval':>7} | "
+          f"{'time (s)':>8} | {'brdfkit/Mitsuba':>15} |")
+    print(f"|{'-' * 22}|{'-' * 18}|{'-' * 11}|{'-' * 9}|{'-' * 10}|{'-' * 17}|")
     for impl, name, rate, t in rows:
         other = ratio.get((impl, name))
         r = ""
@@ -276,8 +288,10 @@ def main(argv=None) -> int:
         elif impl.startswith("Mitsuba"):
             mine = {v: k for k, v in ratio.items()}[(impl.split()[0], name)]
             r = f"(vs {mine[1]})"
-        print(f"| {impl:<20} | {name:<16} | {rate / 1e6:9.1f} | {t:8.3f} | {r:>15} |")
+        print(f"| {impl:<20} | {name:<16} | {rate / 1e6:9.1f} | {1e9 / rate:7.1f} | {t:8.3f} | "
+              f"{r:>15} |")
     print()
+    print("load average (1, 5, 15 min): %.2f %.2f %.2f" % os.getloadavg())
     for c in checks:
         print("check:", c)
     if note:
