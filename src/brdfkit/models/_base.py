@@ -27,6 +27,8 @@ Public objects
 - :class:`Param` — a declared parameter.
 - :class:`BRDF` — the base class of all models.
 - :func:`eval_pairs` — the compiled driver (for code that has packed arrays).
+- :func:`eval_pairs_checked` — the same, also testing the directions for NaN/inf
+  in the same pass (what :meth:`BRDF.eval` uses).
 """
 
 from __future__ import annotations
@@ -43,7 +45,7 @@ from brdfkit._array import as_directions, as_uniform
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.geometry import pdf_cosine_hemisphere, sample_cosine_hemisphere
 
-__all__ = ["Param", "Lobe", "BRDF", "eval_pairs"]
+__all__ = ["Param", "Lobe", "BRDF", "eval_pairs", "eval_pairs_checked"]
 
 
 @dataclass(frozen=True)

@@ -9,6 +9,9 @@ Public objects
 --------------
 - :class:`Microfacet` — ``microfacet``: Walter et al. 2007, Beckmann or GGX,
   separable Smith masking, conductor/dielectric Fresnel.
+- :func:`beckmann_g1_of_a` — Beckmann Smith G₁(a), a = cot θ/α, tabulated
+  without libm calls (< 1e-13 relative); :func:`smith_g1_beckmann_exact` is the
+  erf form it is tested against.
 
 References
 ----------
