@@ -85,7 +85,9 @@ def blinn_max(blinn):
 
 @pytest.fixture(scope="module")
 def blinn_ctrl(blinn):
-    return pump_sequence(blinn, "controlled", times=3)
+    # 2 stages: the table of the g2-pumped Blinn needs 512 intervals (its albedo has a
+    # kink where a(θ) crosses cos θ), ~1 min to build; stage 3 is in the report script
+    return pump_sequence(blinn, "controlled", times=2)
 
 
 # --------------------------------------------------------------------------- the model object
@@ -213,34 +215,35 @@ def test_g1_normal_incidence_albedo_is_one(phong_max, blinn_max):
 
 
 def _reciprocal_cases():
+    # g1 for every example, g2 for the first (typical) one: each (model, g) compiles a kernel
     for name, cls in brdfkit.MODELS.items():
         if not cls.reciprocal:
             continue
         for i, ex in enumerate(cls.examples):
-            yield pytest.param(name, ex, id=f"{name}-{i}")
+            for g in (("max", "controlled") if i == 0 else ("max",)):
+                yield pytest.param(name, ex, g, id=f"{name}-{i}-{g}")
 
 
-@pytest.mark.parametrize("name,params", list(_reciprocal_cases()))
-def test_theorem_registry(name, params):
-    """Every registered reciprocal model × example, pumped once with g1 and g2."""
+@pytest.mark.parametrize("name,params,g", list(_reciprocal_cases()))
+def test_theorem_registry(name, params, g):
+    """Every registered reciprocal model × example, pumped once: a <= a* <= 1 at 4 angles."""
     base = brdfkit.model(name, **params)
     th = np.radians([0.0, 45.0, 80.0, 89.9])
     a = _alb(base, th)
-    for g in ("max", "controlled"):
-        with warnings.catch_warnings(record=True) as rec:
-            warnings.simplefilter("always")
-            p = pump(base, g)
-        a1 = _alb(p, th)
-        assert p.reciprocal
-        wi, wo = _random_pairs(20, 7)
-        np.testing.assert_allclose(p.eval(wi, wo), p.eval(wo, wi), rtol=1e-12, atol=0)
-        assert np.all(a1 <= 1.0 + 1e-6), (g, a1)
-        if p.capped:
-            assert np.all(a1 >= a - 1e-6), (g, a1 - a)
-            assert not any(issubclass(w.category, PumpingWarning) for w in rec)
-        else:  # the base gains energy somewhere: eq. 17 cannot hold (see module docstring)
-            assert np.max(p.table.max_albedo) > 1.0
-            assert any(issubclass(w.category, PumpingWarning) for w in rec)
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        p = pump(base, g)
+    a1 = _alb(p, th)
+    assert p.reciprocal
+    wi, wo = _random_pairs(20, 7)
+    np.testing.assert_allclose(p.eval(wi, wo), p.eval(wo, wi), rtol=1e-12, atol=0)
+    assert np.all(a1 <= 1.0 + 1e-6), a1
+    if p.capped:
+        assert np.all(a1 >= a - 1e-6), a1 - a
+        assert not any(issubclass(w.category, PumpingWarning) for w in rec)
+    else:  # the base gains energy somewhere: eq. 17 cannot hold (see brdfkit.pumping)
+        assert np.max(p.table.max_albedo) > 1.0
+        assert any(issubclass(w.category, PumpingWarning) for w in rec)
 
 
 def test_non_plausible_base_made_plausible():
@@ -296,18 +299,18 @@ def test_controlled_radiance_bound_pointwise(name, params):
 
 
 def test_super_metal_g1_vs_g2(blinn, blinn_max, blinn_ctrl, phong, phong_max):
-    """§3.1/§3.2: g1 makes the Blinn mirror overshoot its normal-incidence radiance c;
-    g2 keeps every stage k = 1..3 at or below c (c = f(L, R(L)), constant for Blinn/Phong)."""
+    """§3.1/§3.2: g1 makes the Blinn mirror overshoot its normal-incidence radiance c
+    (c = f(L, R(L)), constant for Blinn/Phong); one g2 stage cannot (proved), and for the
+    Phong, where g2 = g1, the second stage does overshoot (the bound is for one stage)."""
     th = np.radians(np.linspace(0.0, 89.9, 200))
     c_b = float(mirror_radiance(blinn, [0.0])[0])
     assert np.allclose(blinn.eval(_dirs(th), _dirs(th) * [-1, -1, 1]), c_b)  # f(L,R) constant
     over = [mirror_radiance(m, th).max() / c_b for m in blinn_max[1:]]
     assert over[0] > 1.5 and over[2] > over[0]  # super-metal, growing with k
-    for m in blinn_ctrl[1:]:
-        assert mirror_radiance(m, th).max() <= c_b * (1 + 1e-6)
-    # Phong with g1: overshoot too (g1 = g2 here), but mild
+    assert mirror_radiance(blinn_ctrl[1], th).max() <= c_b * (1 + 1e-6)
     c_p = (20 + 2) / (2 * np.pi)
     assert mirror_radiance(phong_max[1], th).max() <= c_p * (1 + 1e-6)
+    assert mirror_radiance(phong_max[2], th).max() > 1.3 * c_p
 
 
 # --------------------------------------------------------------------------- colour, custom g
