@@ -211,6 +211,10 @@ class AlbedoTable:
         The angles of incidence of the nodes (radians).
     n_evaluations : int
         Albedo engine evaluations spent building the table.
+    nondecreasing : ndarray of bool, shape (C,)
+        Whether the spline is non-decreasing in cos θ on every interval (its
+        derivative, a quadratic, checked at the ends and the vertex); then
+        max(a(L), a(V)) = a(max(N·L, N·V)) and the kernel looks up once.
     coloured : bool
         Whether the model returns a channel axis.
     """
@@ -223,6 +227,7 @@ class AlbedoTable:
     theta_nodes: np.ndarray
     n_evaluations: int
     coloured: bool
+    nondecreasing: np.ndarray
 
     @property
     def n_intervals(self) -> int:
@@ -338,13 +343,27 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
     coloured = getattr(model, "n_channels", None) is not None
     return AlbedoTable(coeffs=coeffs, s_top=s_top, max_midpoint_error=max_err, delta=delta,
                        max_albedo=np.maximum(vals.max(axis=0), mid.max(axis=0)),
-                       theta_nodes=thetas(s_nodes), n_evaluations=n_eval, coloured=coloured)
+                       theta_nodes=thetas(s_nodes), n_evaluations=n_eval, coloured=coloured,
+                       nondecreasing=_nondecreasing(coeffs))
 
 
 def _w_of_mu(mu) -> np.ndarray:
     """Table variable w = √(1 − √(1 − μ)) of μ = cos θ (clamped to [0, 1])."""
     r = np.clip(1.0 - np.asarray(mu, dtype=np.float64), 0.0, 1.0)
     return np.sqrt(1.0 - np.sqrt(r))
+
+
+def _nondecreasing(coeffs: np.ndarray) -> np.ndarray:
+    """Per channel: is every cubic non-decreasing on t ∈ [0, 1]? (derivative ≥ 0)."""
+    c0, c1, c2 = coeffs[..., 0], coeffs[..., 1], coeffs[..., 2]
+    d0 = c2  # derivative 3c0 t² + 2c1 t + c2 at t = 0
+    d1 = 3.0 * c0 + 2.0 * c1 + c2  # at t = 1
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tv = np.where(c0 != 0.0, -c1 / (3.0 * c0), -1.0)  # vertex of the quadratic
+    inside = (tv > 0.0) & (tv < 1.0)
+    dv = np.where(inside, 3.0 * c0 * tv * tv + 2.0 * c1 * tv + c2, 0.0)
+    ok = (d0 >= 0.0) & (d1 >= 0.0) & (dv >= 0.0)
+    return np.all(ok, axis=1)
 
 
 def _as_2d(a: np.ndarray) -> np.ndarray:
@@ -386,7 +405,7 @@ def _pumped_kernel(base_kernel, g_code: int):
 
     Packed parameters of one channel (``p``), from the left: the base's
     parameters (K values), the spline coefficients (4 nn), then the header
-    ``[cap, s_top, nn, K]`` read from the right — so the layout nests and a
+    ``[monotone, cap, s_top, nn, K]`` read from the right — so the layout nests and a
     pumped kernel can be pumped again.
     """
     key = (base_kernel, g_code)
@@ -405,9 +424,14 @@ def _pumped_kernel(base_kernel, g_code: int):
             return 0.0  # nothing to pump (outside the lobe): skip the lookups
         nn = int(p[m - 2])
         s_top = p[m - 3]
-        a_i = _table_lookup(p, k, nn, s_top, iz)
-        a_o = _table_lookup(p, k, nn, s_top, oz)
-        g = a_i if a_i > a_o else a_o
+        if p[m - 5] != 0.0:
+            # the tabulated albedo is non-decreasing in cos θ (checked at build time), so
+            # max(a(L), a(V)) = a(max(N·L, N·V)): one lookup instead of two
+            g = _table_lookup(p, k, nn, s_top, iz if iz > oz else oz)
+        else:
+            a_i = _table_lookup(p, k, nn, s_top, iz)
+            a_o = _table_lookup(p, k, nn, s_top, oz)
+            g = a_i if a_i > a_o else a_o
         if controlled:
             if iz > g:
                 g = iz
@@ -505,10 +529,11 @@ class PumpedBRDF(BRDF):
     def _pack(self) -> np.ndarray:
         bp = np.asarray(self.base.packed)
         k = bp.shape[1]
-        header = [1.0 if self.capped else 0.0, self.table.s_top,
-                  float(self.table.n_intervals), float(k)]
-        rows = [np.concatenate([bp[c], self.table.packed(c), header])
-                for c in range(bp.shape[0])]
+        rows = []
+        for c in range(bp.shape[0]):
+            header = [1.0 if self.table.nondecreasing[c] else 0.0, 1.0 if self.capped else 0.0,
+                      self.table.s_top, float(self.table.n_intervals), float(k)]
+            rows.append(np.concatenate([bp[c], self.table.packed(c), header]))
         return np.ascontiguousarray(np.array(rows, dtype=np.float64))
 
     # -------------------------------------------------------------- evaluation
