@@ -289,3 +289,129 @@ def test_describe_is_complete(cls):
     assert brdfkit.model(cls.name).name == cls.name
     for alias in cls.aliases:
         assert brdfkit.model(alias).name == cls.name
+
+
+# --------------------------------------------------------------------------- grazing angles
+# Cosines that are tiny but positive: subnormal (5e-324 is the smallest float64), where the
+# squares of the components of wi + wo underflow (< 1.5e-154), and ordinary small ones.
+TINY_COS = (5e-324, 1e-320, 1e-310, 1e-300, 1e-200, 1e-162, 1e-150, 1e-100, 1e-20)
+
+
+def _grazing(z, phi=0.0):
+    """The unit vector at cos θ = z and azimuth phi; exact components at multiples of π/2
+    (cos π rounds to −1 but sin π to 1.2e-16, which would move the pair off the mirror)."""
+    s = math.sqrt(1.0 - z * z)
+    exact = {0.0: (1.0, 0.0), math.pi: (-1.0, 0.0), math.pi / 2: (0.0, 1.0),
+             -math.pi / 2: (0.0, -1.0)}
+    c, sn = exact.get(phi, (math.cos(phi), math.sin(phi)))
+    return (s * c, s * sn, z)
+
+
+def grazing_pairs():
+    """(wi, wo) pairs at extreme grazing angles, and pairs at/below the horizon.
+
+    Both grazing: forward (wo the mirror image, h = n), retro-reflection (wi = wo),
+    perpendicular azimuths, wi = −wo + a tiny azimuthal offset, and every combination of two
+    different tiny cosines; one grazing, the other at 0°, 60° or 89.94° on either side;
+    and z = 0, −0, −5e-324, −1e-300 (the BRDF must be exactly 0 there).
+    """
+    pairs = []
+    for e in TINY_COS:
+        g = _grazing(e)
+        pairs += [(g, _grazing(e, math.pi)), (g, g), (g, _grazing(e, math.pi / 2)),
+                  (g, _grazing(e, -math.pi / 2))]
+        pairs += [(_grazing(e, d), _grazing(e, math.pi)) for d in (1e-8, 1e-100, 1e-300)]
+        for c in (1.0, 0.5, 1e-3):
+            for phi in (0.0, math.pi):
+                pairs += [(g, _grazing(c, phi)), (_grazing(c, phi), g)]
+        for e2 in TINY_COS:
+            pairs += [(g, _grazing(e2, math.pi)), (g, _grazing(e2))]
+    for z in (0.0, -0.0, -5e-324, -1e-300):
+        pairs += [((1.0, 0.0, z), (-1.0, 0.0, z)), ((1.0, 0.0, z), (0.0, 0.0, 1.0)),
+                  ((0.0, 0.0, 1.0), (1.0, 0.0, z)), ((1.0, 0.0, z), (1.0, 0.0, z))]
+    wi = np.array([p[0] for p in pairs])
+    wo = np.array([p[1] for p in pairs])
+    return wi, wo
+
+
+def assert_finite_nonnegative_zero_below(m, label):
+    # Reference: the package conventions (issue 2): f is finite and ≥ 0 for θ ≤ 90°, and
+    # exactly 0 when either cosine is ≤ 0.
+    wi, wo = grazing_pairs()
+    assert np.min(wi[wi[:, 2] > 0.0, 2]) == 5e-324  # the smallest subnormal is covered
+    f = np.asarray(m.eval(wi, wo)).reshape(len(wi), -1)
+    bad = ~np.all(np.isfinite(f) & (f >= 0.0), axis=1)
+    below = (wi[:, 2] <= 0.0) | (wo[:, 2] <= 0.0)
+    bad |= below & np.any(f != 0.0, axis=1)
+    if np.any(bad):
+        j = np.argwhere(bad)[0][0]
+        pytest.fail(f"{label}: f = {f[j]} at wi = {wi[j].tolist()}, wo = {wo[j].tolist()} "
+                    f"({int(bad.sum())} bad pairs)")
+
+
+@pytest.mark.parametrize("cls,i,ex", CASES)
+def test_finite_at_extreme_grazing_angles(cls, i, ex):
+    assert_finite_nonnegative_zero_below(cls(**ex), f"{cls.name} {ex}")
+
+
+def extreme_parameter_sets(cls):
+    """Every choice, and each parameter at each finite closed bound (others at default)."""
+    out = []
+    for p in cls.params:
+        if p.kind == "choice":
+            out += [{p.name: c} for c in p.choices]
+            continue
+        for bound, is_open in ((p.lower, p.lower_open), (p.upper, p.upper_open)):
+            if math.isfinite(bound) and not is_open:
+                out.append({p.name: [bound] if p.kind == "lobes" else bound})
+    choices = [p for p in cls.params if p.kind == "choice"]
+    if choices:  # the bounds again under every choice of the first choice parameter
+        c0 = choices[0]
+        out += [{**v, c0.name: c} for v in list(out) if c0.name not in v for c in c0.choices]
+    return out
+
+
+@pytest.mark.parametrize("cls", CLASSES)
+def test_finite_at_extreme_grazing_angles_and_parameter_bounds(cls):
+    # e.g. phong with k_s = 1e6 (f ∝ k_s/N·L) or neumann-phong with c_n = 1e7
+    tried = 0
+    for values in extreme_parameter_sets(cls):
+        try:
+            m = cls(**values)
+        except ParameterError:
+            continue  # a combination another parameter's bounds exclude (e.g. c with D3)
+        assert_finite_nonnegative_zero_below(m, f"{cls.name} {values}")
+        tried += 1
+    assert tried > 0 or not any(p.kind != "choice" for p in cls.params)
+
+
+# Limits as both cosines → 0 with wo the mirror image of wi (so h = n, L·V → −1, R·V → 1,
+# ω_i·h = |wi + wo|/2 → 0 and F(0) = 1), from the formulas, at cosines where the components
+# of wi + wo underflow when squared (the case the kernels once returned 0, NaN or inf for):
+#   microfacet beckmann: D(h=n) = 1/(πα²), G₁/cos θ → 2√π/(α h(0)) with h(0) = 1 (Walter
+#       eq. 27 as a → 0): f → (1/(πα²))(4π/α²)/4 = 1/α⁴;
+#   microfacet ggx: D = 1/(πα²), G₁/cos θ → 2/α (eq. 34): f → 1/(πα⁴);
+#   nielsen (eq. 3): base (1−α)R·V + α(N·H)⁴ → 1, f → ρ_d/π + k_s;
+#   phong-blinn-reciprocal (Lewis eq. 24): (N·H)ⁿ = 1, f = k_d + k_s;
+#   modified-blinn-phong (Nielsen eq. 2): f = ρ_d/π + ρ_s (n+8)/(8π);
+#   cook-torrance (Neumann eq. 9): D = 1/(4πm²), G = 1, (N·L)(N·V) floored at DENOM_FLOOR
+#       = 1e-280 (documented in brdfkit.models.microfacet): f = ρ_s/(4πm²)·1e280.
+GRAZING_LIMITS = [
+    ("microfacet", {"alpha": 0.1}, 1.0 / 0.1**4),
+    ("microfacet", {"alpha": 0.5, "eta": 1.5, "k": 2.0}, 1.0 / 0.5**4),
+    ("microfacet", {"distribution": "ggx", "alpha": 0.5}, 1.0 / (math.pi * 0.5**4)),
+    ("nielsen", {"rho_d": 0.2, "k_s": 2.0, "alpha": 0.5, "s": 20.0}, 0.2 / math.pi + 2.0),
+    ("nielsen", {"rho_d": 0.0, "k_s": 3.0, "alpha": 0.7, "s": 8.0, "eta": 1.5}, 3.0),
+    ("phong-blinn-reciprocal", {"k_d": 0.1, "k_s": 1.0, "n": 20.0}, 1.1),
+    ("modified-blinn-phong", {"rho_d": 0.2, "rho_s": 0.5, "n": 20.0},
+     0.2 / math.pi + 0.5 * 28.0 / (8.0 * math.pi)),
+    ("cook-torrance", {"m": 0.3}, 1e280 / (4.0 * math.pi * 0.09)),
+]
+
+
+@pytest.mark.parametrize("name,values,limit", GRAZING_LIMITS)
+@pytest.mark.parametrize("e", [1e-150, 1e-162, 1e-200, 1e-300, 1e-320, 5e-324])
+def test_grazing_mirror_limit(name, values, limit, e):
+    m = brdfkit.model(name, **values)
+    f = float(m.eval(np.array(_grazing(e)), np.array(_grazing(e, math.pi))))
+    assert f == pytest.approx(limit, rel=1e-12), f"{name} {values} at cos = {e}"

@@ -12,6 +12,8 @@ Public objects
 - :func:`beckmann_g1_of_a` — Beckmann Smith G₁(a), a = cot θ/α, tabulated
   without libm calls (< 1e-13 relative); :func:`smith_g1_beckmann_exact` is the
   erf form it is tested against.
+- :func:`ggx_g1_over_cos` — GGX G₁(v)/cos θ_v (Walter eq. 34) without a division
+  by the cosine: finite and accurate down to cos θ_v = 0 (subnormal cosines).
 
 References
 ----------
@@ -28,7 +30,7 @@ import numba
 import numpy as np
 
 from brdfkit._array import as_directions, as_uniform, stack
-from brdfkit._kern import INV_PI, below_horizon, half, pos_pow
+from brdfkit._kern import INV_PI, SMALL_LENGTH, below_horizon, half, pos_pow
 from brdfkit.errors import ParameterError
 from brdfkit.fresnel import _fresnel_conductor, _fresnel_dielectric
 from brdfkit.geometry import sample_cosine_hemisphere
@@ -174,6 +176,19 @@ def smith_g1_beckmann(cos_v: float, cos_vh: float, alpha: float) -> float:
 
 
 @_jit
+def ggx_g1_over_cos(cos_v: float, alpha: float) -> float:
+    """G₁(v)/cos θ_v for GGX (Walter eq. 34, v·h > 0 assumed): 2/(c + √(c² + α² sin²θ_v)).
+
+    Equal to :func:`smith_g1_ggx` divided by c = cos θ_v (multiply the numerator and the
+    denominator of 2/(1 + √(1 + α² tan²θ_v)) by c), but with no division by c or c²: the
+    denominator is ≥ max(c, α sin θ_v) > 0, so the ratio is finite and accurate down to
+    c = 0 (→ 2/α), where G₁ and c both underflow and G₁/c would be 0/0.
+    """
+    c2 = cos_v * cos_v
+    return 2.0 / (cos_v + math.sqrt(c2 + alpha * alpha * max(0.0, 1.0 - c2)))  # clamp: rounding
+
+
+@_jit
 def smith_g1_ggx(cos_v: float, cos_vh: float, alpha: float) -> float:
     """Smith masking for GGX, Walter eq. (34): 2/(1 + √(1 + α² tan²θ_v))."""
     if cos_v <= 0.0 or cos_vh <= 0.0:
@@ -199,7 +214,8 @@ def _beckmann_dgg(iz, oz, sxy2, sz2, alpha):
 
     The fast path of :func:`_microfacet` (same values as d_beckmann and
     smith_g1_beckmann to ~1e-14 relative): four divisions instead of eleven,
-    no libm call but one exp, and the G₁ = 1 cases as selects, not branches. With tan²θ_h = |s_xy|²/s_z² (s = wi + wo) and
+    no libm call but one exp, and the G₁ = 1 cases as selects, not branches. With
+    tan²θ_h = |s_xy|²/s_z² (s = wi + wo) and
     G₁(v)/cos θ_v = 2√π/(α sin θ_v h(a_v)) for a_v < 6 (1/cos θ_v for a_v ≥ 6,
     where G₁ = 1 exactly), the cosines cancel out of the denominator, so that
     nothing underflows at grazing angles.
@@ -208,8 +224,8 @@ def _beckmann_dgg(iz, oz, sxy2, sz2, alpha):
     t = sxy2 / sz2  # tan²θ_h, without the cancellation of (1 − cos²)/cos²
     e = -t * (1.0 / a2)  # −tan²θ_h/α² (1/α² is loop-invariant: hoisted by the compiler)
     if not e >= -700.0:
-        # D < 1e-290: see d_beckmann. "not ≥" also catches e = NaN (0/0 when s_z² underflows
-        # with s_xy = 0: both directions within 1e-162 of the horizon), returned as 0.
+        # D < 1e-290: see d_beckmann. "not ≥" also catches e = NaN (0/0 if s_z² underflows
+        # with s_xy = 0); _microfacet avoids that case with _beckmann_grazing.
         return 0.0
     # D = e^{−tan²/α²}/(π α² cos⁴θ_h) with 1/cos²θ_h = 1 + tan²θ_h (≤ 1 + 700 α² here)
     sec2 = 1.0 + t
@@ -227,6 +243,23 @@ def _beckmann_dgg(iz, oz, sxy2, sz2, alpha):
     return math.exp(e) * (sec2 * sec2) * ni * no / (4.0 * math.pi * a2 * di * do)
 
 
+@numba.njit(cache=True)
+def _beckmann_grazing(iz, oz, sx, sy, sz, alpha, eta, k):
+    """F D G₁G₁/(4 cos cos) for Beckmann when s = wi + wo is shorter than SMALL_LENGTH.
+
+    The slow path of :func:`_microfacet` (not inlined): the squares of the components of s
+    underflow there, so that tan²θ_h = |s_xy|²/s_z² would be 0/0 (or inaccurate). The
+    components are scaled by the largest one first; tan²θ_h is scale-invariant and
+    |s| = m·|s/m| (for the Fresnel factor at ω_i·h = |s|/2).
+    """
+    m = max(abs(sx), abs(sy), sz)  # ≥ sz > 0 above the horizon
+    a, b, c = sx / m, sy / m, sz / m
+    sxy2 = a * a + b * b
+    sz2 = c * c  # ≥ 1/3: no underflow
+    f = 1.0 if eta == 0.0 else _fresnel_conductor(0.5 * m * math.sqrt(sxy2 + sz2), eta, k)
+    return f * _beckmann_dgg(iz, oz, sxy2, sz2, alpha)
+
+
 @numba.njit(cache=True, error_model="numpy", fastmath=_FAST)
 def _microfacet(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
@@ -240,16 +273,22 @@ def _microfacet(ix, iy, iz, ox, oy, oz, p):
     l2 = sxy2 + sz2
     # ω_i·h = (1 + wi·wo)/|wi + wo| = |wi + wo|/2 (the same for wo); |wi + wo| ≥ s_z > 0
     if dist == BECKMANN:
+        if sz < SMALL_LENGTH:  # rare: both directions within 1e-140 of the horizon
+            return scale * _beckmann_grazing(iz, oz, sx, sy, sz, alpha, eta, k)
         if eta == 0.0:  # eta not given: F = 1 (and no square root needed)
             return scale * _beckmann_dgg(iz, oz, sxy2, sz2, alpha)
         f = _fresnel_conductor(0.5 * math.sqrt(l2), eta, k)
         return scale * f * _beckmann_dgg(iz, oz, sxy2, sz2, alpha)
     hx, hy, hz, length = half(ix, iy, iz, ox, oy, oz)  # GGX: the general (slower) path
-    cos_ih = ix * hx + iy * hy + iz * hz
+    cos_ih = ix * hx + iy * hy + iz * hz  # = |wi + wo|/2 = cos_oh; > 0 up to rounding
+    if cos_ih <= 0.0:
+        return 0.0  # χ⁺(v·h) of eq. (34) (as smith_g1_ggx)
     f = 1.0 if eta == 0.0 else _fresnel_conductor(cos_ih, eta, k)  # eta not given: F = 1
     d = d_ggx(hz, alpha)
-    g = smith_g1_ggx(iz, cos_ih, alpha) * smith_g1_ggx(oz, cos_ih, alpha)
-    return scale * f * d * g / (4.0 * iz * oz)
+    # G₁/cos per direction (ggx_g1_over_cos): G₁(ω_i)G₁(ω_o)/(4 cos θ_i cos θ_o) without the
+    # 0/0 of an underflowing numerator and denominator at grazing angles
+    g = ggx_g1_over_cos(iz, alpha) * ggx_g1_over_cos(oz, alpha)
+    return scale * f * d * g * 0.25
 
 
 @register
@@ -660,16 +699,41 @@ _TS_FROM_BETA = {
 
 
 # =========================================================================== Cook-Torrance
+@numba.njit(cache=True)
+def _cook_torrance_grazing(iz, oz, sx, sy, sz, m, eta, rho_s):
+    """:func:`_cook_torrance` when s = wi + wo is shorter than SMALL_LENGTH (not inlined).
+
+    The squares of the components of s underflow there (cos²δ = s_z²/|s|² would be 0/0,
+    which the kernel returned as 0). Written with s/q, q the largest component: cos δ and
+    tan δ are scale-invariant, |s| = q|s/q| and 4 s_z (N·V)/|s|² = 4 (s_z/q)(N·V)/(q|s/q|²).
+    """
+    q = max(abs(sx), abs(sy), sz)  # ≥ sz > 0 above the horizon
+    a, b, c = sx / q, sy / q, sz / q
+    l2 = a * a + b * b + c * c  # in [1, 3]: no underflow
+    root = math.sqrt(l2)
+    c2 = c * c / l2  # cos²δ
+    e = -(1.0 - c2) / (c2 * m * m)
+    if not e >= -700.0:
+        return 0.0  # D < 1e-290 (see beckmann_lobe)
+    d = math.exp(e) / (4.0 * math.pi * m * m * c2 * c2)
+    g = min(1.0, 4.0 * c * min(iz, oz) / (l2 * q))  # ≤ 4c²/l2 since min(iz, oz) ≤ s_z = c q
+    f = 1.0 if eta == 0.0 else _fresnel_dielectric(0.5 * q * root, eta)
+    return rho_s * f * d * g / max(iz * oz, DENOM_FLOOR)  # floor: see DENOM_FLOOR
+
+
 @numba.njit(cache=True, error_model="numpy", fastmath=_FAST)
 def _cook_torrance(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
     m, eta, rho_s = p[0], p[1], p[2]
-    # Written with s = wi + wo (five divisions, one square root): cos²δ = s_z²/|s|², tan²δ = |s_xy|²/s_z²,
+    # Written with s = wi + wo (five divisions, one square root): cos²δ = s_z²/|s|²,
+    # tan²δ = |s_xy|²/s_z²,
     # L·H = V·H = |s|/2 (unit vectors) and, in eq. (10), 2(N·H)(N·V)/(V·H) = 4 s_z (N·V)/|s|².
     sx = ix + ox
     sy = iy + oy
     sz = iz + oz  # > 0 above the horizon
+    if sz < SMALL_LENGTH:  # rare: both directions within 1e-140 of the horizon
+        return _cook_torrance_grazing(iz, oz, sx, sy, sz, m, eta, rho_s)
     sxy2 = sx * sx + sy * sy
     sz2 = sz * sz
     l2 = sxy2 + sz2

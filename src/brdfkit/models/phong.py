@@ -51,7 +51,15 @@ import numba
 import numpy as np
 
 from brdfkit._array import as_directions, as_uniform, stack
-from brdfkit._kern import INV_PI, INV_TWO_PI, below_horizon, n_dot_h, r_dot_v
+from brdfkit._kern import (
+    INV_PI,
+    INV_TWO_PI,
+    SMALL_LENGTH,
+    below_horizon,
+    n_dot_h,
+    r_dot_v,
+    scaled_length,
+)
 from brdfkit.errors import ParameterError
 from brdfkit.fresnel import _fresnel_dielectric
 from brdfkit.geometry import (
@@ -76,6 +84,14 @@ K_D = Param("k_d", 0.1, 0.0, 1.0, "1/sr",
 K_S = Param("k_s", 1.0, 0.0, 1e6, "1/sr",
             "specular coefficient (unnormalised; (n+2)/2pi gives unit normal-incidence "
             "albedo for the R.V lobe)", kind="colour")
+
+
+# Floor of a cosine that divides (1/(N·L) in phong and blinn, 1/max(N·L, N·V) in
+# neumann-phong). The true value overflows float64 when the cosine is subnormal; with the
+# floor f ≤ k_s·1e300 ≤ 1e306 (k_s ≤ 1e6) and ≤ c_n·1e300 ≤ 1e307 (c_n ≤ 1e7): finite for
+# every accepted parameter. Cost: f is too small by the factor cos/1e-300 only for cosines
+# below 1e-300 (θ within 1e-300 rad of 90°), where float64 cannot represent it anyway.
+COS_DIVISOR_FLOOR = 1e-300
 
 
 # --------------------------------------------------------------------------- kernel helper
@@ -548,8 +564,9 @@ def _phong(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
     k_d, k_s, n = p[0], p[1], p[2]
-    # Lewis eq. (8) with F_s^P of eq. (5); iz = N·L > 0 here, so the division is finite
-    return k_d + k_s * lobe_pow(r_dot_v(ix, iy, iz, ox, oy, oz), n) / iz
+    # Lewis eq. (8) with F_s^P of eq. (5). The true f diverges like 1/(N·L) and overflows
+    # float64 for N·L < k_s/1.8e308; N·L is floored at COS_DIVISOR_FLOOR (see there)
+    return k_d + k_s * lobe_pow(r_dot_v(ix, iy, iz, ox, oy, oz), n) / max(iz, COS_DIVISOR_FLOOR)
 
 
 @register
@@ -613,8 +630,8 @@ def _blinn(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
     k_d, k_s, n = p[0], p[1], p[2]
-    # Lewis eq. (8) with F_s^B of eq. (6); iz = N·L > 0 here
-    return k_d + k_s * lobe_pow(n_dot_h(ix, iy, iz, ox, oy, oz), n) / iz
+    # Lewis eq. (8) with F_s^B of eq. (6); N·L floored as in _phong (COS_DIVISOR_FLOOR)
+    return k_d + k_s * lobe_pow(n_dot_h(ix, iy, iz, ox, oy, oz), n) / max(iz, COS_DIVISOR_FLOOR)
 
 
 @register
@@ -1113,8 +1130,9 @@ def _neumann_phong(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
     c_n, n = p[0], p[1]
-    # max(N·L, N·V) > 0 above the horizon, so the division is finite
-    return c_n * lobe_pow(r_dot_v(ix, iy, iz, ox, oy, oz), n) / max(iz, oz)
+    # max(N·L, N·V) > 0 above the horizon but can be subnormal (both directions within
+    # 1e-300 of the horizon), where c_n/max overflows; floored at COS_DIVISOR_FLOOR (see there)
+    return c_n * lobe_pow(r_dot_v(ix, iy, iz, ox, oy, oz), n) / max(iz, oz, COS_DIVISOR_FLOOR)
 
 
 @register
@@ -1200,8 +1218,15 @@ def _nielsen(ix, iy, iz, ox, oy, oz, p):
     # grazing opposite directions).
     lv = ix * ox + iy * oy + iz * oz
     sx, sy, sz = ix + ox, iy + oy, iz + oz
-    length = math.sqrt(sx * sx + sy * sy + sz * sz)  # ≥ sz > 0 above the horizon
-    hz = sz / length
+    length = math.sqrt(sx * sx + sy * sy + sz * sz)  # ≥ sz > 0 above the horizon, but:
+    if length < SMALL_LENGTH:
+        # rare: the squares underflowed (grazing, nearly opposite directions); 0 here would
+        # give hz = inf. Scale by the largest component first (brdfkit._kern.half).
+        length = scaled_length(sx, sy, sz)
+        m = max(abs(sx), abs(sy), sz)
+        hz = (sz / m) / (length / m)
+    else:
+        hz = sz / length
     f = 1.0 if eta == 0.0 else _fresnel_dielectric(0.5 * length, eta)  # no eta: F = 1
     hz2 = hz * hz
     base = (1.0 - alpha) * (2.0 * iz * oz - lv) + alpha * hz2 * hz2
