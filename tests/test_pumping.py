@@ -214,13 +214,21 @@ def test_g1_normal_incidence_albedo_is_one(phong_max, blinn_max):
             assert _alb(seq[k], [0.0])[0] == pytest.approx(1.0, abs=1e-5)
 
 
+#: Models whose kernel is slow enough (He–Torrance's series: ~90 s per pumped case under
+#: load) that only the first example is pumped, with g1 only.
+SLOW_MODELS = {"he-torrance"}
+
+
 def _reciprocal_cases():
     # g1 for every example, g2 for the first (typical) one: each (model, g) compiles a kernel
     for name, cls in brdfkit.MODELS.items():
         if not cls.reciprocal:
             continue
         for i, ex in enumerate(cls.examples):
-            for g in (("max", "controlled") if i == 0 else ("max",)):
+            if name in SLOW_MODELS and i > 0:
+                continue
+            gs = ("max", "controlled") if i == 0 and name not in SLOW_MODELS else ("max",)
+            for g in gs:
                 yield pytest.param(name, ex, g, id=f"{name}-{i}-{g}")
 
 
