@@ -240,3 +240,31 @@ def test_quadrature_vs_monte_carlo(name, params):
     assert np.all(np.isfinite(q.albedo))
     assert np.all(np.abs(q.albedo - mc.albedo) <= 5 * mc.error + 1e-6), (q.albedo, mc.albedo,
                                                                          mc.error)
+
+
+def test_memory_bounded_for_a_pathological_integrand():
+    """A step no break point knows about never meets tol = 1e-9, so every angle refines to
+    the deepest level. Before the node bound this allocated ~10 GB (16 angles x ~9e6 nodes
+    at level 5 at once); now the angles go in chunks and an angle stops refining when its
+    next level would exceed MAX_ANGLE_NODES. Peak measured with tracemalloc (NumPy reports
+    its buffers to it)."""
+    import tracemalloc
+
+    def f(wi, wo):
+        return np.where(wo[..., 0] > 0.3, 1.0, 0.0) / np.pi
+
+    th = np.radians(np.linspace(0.0, 89.0, 16))
+    tracemalloc.start()
+    try:
+        r = albedo(f, th, tol=1e-9, mode="mirror", width=0.05)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < 1.2 * 2**30
+    # exact: (1/π) × area of the unit disk with x > 0.3 (the projected-solid-angle measure)
+    x = 0.3
+    exact = (math.acos(x) - x * math.sqrt(1.0 - x * x)) / math.pi
+    err = np.abs(r.albedo - exact)
+    assert err.max() < 2e-3  # still a good estimate
+    assert np.all(r.error > 1e-9)  # reported as not converged: the estimate stays large
+    assert np.all(err <= 5.0 * r.error + 1e-12)  # and of the right size

@@ -489,6 +489,42 @@ def evaluate_pairs(model, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
     return np.asarray(model(wi, wo), dtype=np.float64).reshape(wi.shape[0], -1)
 
 
+#: Memory bounds of :func:`_integrate`: nodes evaluated per call of ``evaluate`` (about
+#: 56 + 8C bytes each for a compiled model, ~3x that for a callable) and the most nodes one
+#: angle may use. Level 5 of a sharp mirror lobe needs ~9e6 nodes per angle (a table of 64
+#: angles at once allocated 19 GB before the bound); past the bound the previous level's
+#: result and its error estimate are returned.
+MAX_CHUNK_NODES = 3_000_000
+MAX_ANGLE_NODES = 6_000_000
+
+
+def _integrate_chunk(evaluate, th, mode, width, level, sym, nvnl, counts, npieces, a, e,
+                     idx, tol) -> np.ndarray:
+    """One level for the angles ``th`` (results written to a[idx], e[idx]); returns the
+    mask of angles whose error estimate is still above the goal."""
+    th = np.ascontiguousarray(th)
+    lv = np.full(th.size, level, dtype=np.int64)
+    offsets = np.zeros(th.size + 1, dtype=np.int64)
+    np.cumsum(counts, out=offsets[1:])
+    total = int(offsets[-1])
+    wo = np.empty((total, 3))
+    wk = np.empty(total)
+    wg = np.empty(total)
+    piece = np.empty(total, dtype=np.int64)
+    big = total >= PARALLEL_NODES
+    gen = _gen_all_parallel if big else _gen_all_serial
+    gen(mode, th, width, lv, sym, _X, _WK, _WGAUSS, offsets, wo, wk, wg, piece, nvnl)
+    vals = np.ascontiguousarray(evaluate(th, offsets, wo), dtype=np.float64)
+    del wo
+    aa = np.empty((th.size, vals.shape[1]))
+    ee = np.empty_like(aa)
+    red = _reduce_all_parallel if big else _reduce_all_serial
+    red(vals, wk, wg, piece, offsets, np.ascontiguousarray(npieces), aa, ee)
+    a[idx] = aa
+    e[idx] = ee
+    return np.any(ee > np.maximum(tol, 1e-10 * np.abs(aa)), axis=1)
+
+
 def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool, tol: float,
                n_channels: int, nvnl: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Level loop shared by the compiled and the callable paths.
@@ -501,32 +537,33 @@ def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool,
     levels = np.zeros(n, dtype=np.int64)
     todo = np.arange(n)
     for level in range(MAX_LEVEL + 1):
-        th = np.ascontiguousarray(thetas[todo])
-        lv = np.full(th.size, level, dtype=np.int64)
-        counts = np.empty(th.size, dtype=np.int64)
-        npieces = np.empty(th.size, dtype=np.int64)
-        for k, t in enumerate(th):
+        counts = np.empty(todo.size, dtype=np.int64)
+        npieces = np.empty(todo.size, dtype=np.int64)
+        for k, t in enumerate(thetas[todo]):
             counts[k], npieces[k] = _count_nodes(mode, float(t), width, level, sym, _X, nvnl)
-        offsets = np.zeros(th.size + 1, dtype=np.int64)
-        np.cumsum(counts, out=offsets[1:])
-        total = int(offsets[-1])
-        wo = np.empty((total, 3))
-        wk = np.empty(total)
-        wg = np.empty(total)
-        piece = np.empty(total, dtype=np.int64)
-        big = total >= PARALLEL_NODES
-        gen = _gen_all_parallel if big else _gen_all_serial
-        gen(mode, th, width, lv, sym, _X, _WK, _WGAUSS, offsets, wo, wk, wg, piece, nvnl)
-        vals = np.ascontiguousarray(evaluate(th, offsets, wo), dtype=np.float64)
-        aa = np.empty((th.size, vals.shape[1]))
-        ee = np.empty_like(aa)
-        red = _reduce_all_parallel if big else _reduce_all_serial
-        red(vals, wk, wg, piece, offsets, npieces, aa, ee)
-        a[todo] = aa
-        e[todo] = ee
-        levels[todo] = level
-        bad = np.any(ee > np.maximum(tol, 1e-10 * np.abs(aa)), axis=1)
-        todo = todo[bad]
+        if level > 0:
+            # memory bound: an angle whose next level needs more than MAX_ANGLE_NODES keeps
+            # the previous level's estimate and its (larger, honest) error estimate
+            fits = counts <= MAX_ANGLE_NODES
+            todo, counts, npieces = todo[fits], counts[fits], npieces[fits]
+            if todo.size == 0:
+                break
+        # angles in chunks of at most MAX_CHUNK_NODES nodes (one angle may exceed it alone)
+        start = 0
+        still = []
+        while start < todo.size:
+            stop = start + 1
+            acc = int(counts[start])
+            while stop < todo.size and acc + int(counts[stop]) <= MAX_CHUNK_NODES:
+                acc += int(counts[stop])
+                stop += 1
+            idx = todo[start:stop]
+            bad = _integrate_chunk(evaluate, thetas[idx], mode, width, level, sym, nvnl,
+                                   counts[start:stop], npieces[start:stop], a, e, idx, tol)
+            levels[idx] = level
+            still.append(idx[bad])
+            start = stop
+        todo = np.concatenate(still) if still else todo[:0]
         if todo.size == 0:
             break
     return a, e, levels
