@@ -121,7 +121,7 @@ def _k2_cos(t, s, c):
 
 
 @numba.njit(cache=True)
-def _t_breaks(mode, theta, width, out):
+def _t_breaks(mode, theta, width, out, kv):
     """Sorted break points of the t axis (including 0 and t_max); returns their count."""
     tmax = _t_max(mode, theta)
     e = 0.5 * math.pi - theta  # elevation of ω_i (and of R) above the horizon
@@ -170,9 +170,25 @@ def _t_breaks(mode, theta, width, out):
                         n += 1
                 prev = cur
                 prev_t = t
+    for i in range(kv.shape[0]):
+        lev = kv[i]
+        if not (lev > -1.0 and lev < 1.0) or n >= 44:
+            continue
+        # where the curve N·V = lev meets φ = 0 or π (the signed θ_o there is t ∓ θ in the
+        # mirror frame, 2t ∓ θ in the half frame), or the circle itself (normal frame)
+        to = math.acos(lev)
+        if mode == NORMAL:
+            cand[n] = to
+            n += 1
+        else:
+            sc = 1.0 if mode == MIRROR else 0.5
+            cand[n] = sc * (theta + to)
+            cand[n + 1] = sc * abs(theta - to)
+            cand[n + 2] = sc * (to - theta)
+            n += 3
     w = max(min(width, 0.5 * math.pi), 1e-9)
     b = w
-    while b < tmax and n < 60:
+    while b < tmax and n < 62:
         cand[n] = b
         n += 1
         # lobes fall off like exp(−(t/w)²): beyond 8w only the broad part remains
@@ -195,13 +211,17 @@ def _t_breaks(mode, theta, width, out):
 
 
 @numba.njit(cache=True)
-def _phi_breaks(mode, t, s, c, level, out, nvnl=False):
+def _phi_breaks(mode, t, s, c, level, out, nvnl, kv):
     """Break points 0 = b₀ < … < b_k = φ_max of the azimuth at polar angle t; returns k + 1.
 
     φ_max is where ω_o meets the horizon (closed form). In half-vector mode
     the azimuths where the branches of the V-groove G cross are added:
     2(N·H)(N·L) = L·H, 2(N·H)(N·V) = V·H, and N·V = N·L, each of the form
     cos φ = (d* − c cos t)/(s sin t) for the value d* of ω_i·h on that curve.
+    The curves N·V = k for the levels k in ``kv`` (model-declared kinks, see
+    :func:`albedo`) are added in the mirror and half frames:
+    mirror: N·V = c cos t + s sin t cos φ, so cos φ = (k − c cos t)/(s sin t);
+    half: N·V = 2(ω_i·h) cos t − c, so ω_i·h = (k + c)/(2 cos t).
     """
     st = math.sin(t)
     ct = math.cos(t)
@@ -238,6 +258,26 @@ def _phi_breaks(mode, t, s, c, level, out, nvnl=False):
             if 1e-12 < ph < phimax - 1e-12:
                 out[k] = ph
                 k += 1
+    if mode != NORMAL and s * st > 1e-300 and phimax > 0.0:
+        for i in range(kv.shape[0]):
+            lev = kv[i]
+            if not (lev > -1.0 and lev < 1.0) or k >= out.shape[0] - 8:
+                continue  # NaN: no kink at this angle
+            if mode == MIRROR:
+                cp = (lev - c * ct) / (s * st)
+            else:
+                if ct <= 0.0:
+                    continue
+                cp = ((lev + c) / (2.0 * ct) - c * ct) / (s * st)
+            if -1.0 < cp < 1.0:
+                ph = math.acos(cp)
+                dup = False
+                for q in range(1, k):
+                    if abs(out[q] - ph) <= 1e-12:
+                        dup = True
+                if not dup and 1e-12 < ph < phimax - 1e-12:
+                    out[k] = ph
+                    k += 1
     if mode == HALF and s * st > 1e-300 and phimax > 0.0:
         dstar = np.empty(3)
         nd = 0
@@ -255,14 +295,14 @@ def _phi_breaks(mode, t, s, c, level, out, nvnl=False):
                 if 1e-12 < ph < phimax - 1e-12:
                     out[k] = ph
                     k += 1
-        # insertion sort of out[1:k]
-        for i in range(2, k):
-            v = out[i]
-            j = i - 1
-            while j >= 1 and out[j] > v:
-                out[j + 1] = out[j]
-                j -= 1
-            out[j + 1] = v
+    # insertion sort of out[1:k]
+    for i in range(2, k):
+        v = out[i]
+        j = i - 1
+        while j >= 1 and out[j] > v:
+            out[j + 1] = out[j]
+            j -= 1
+        out[j + 1] = v
     out[k] = phimax
     return k + 1
 
@@ -299,13 +339,13 @@ def _direction(mode, st, ct, phi, s, c):
 
 
 @numba.njit(cache=True)
-def _count_nodes(mode, theta, width, level, sym, X, nvnl=False):
+def _count_nodes(mode, theta, width, level, sym, X, nvnl, kv):
     """Exact number of nodes :func:`_gen_nodes` writes, and the number of error pieces."""
     tb = np.empty(64)
-    pb = np.empty(8)
-    nt = _t_breaks(mode, theta, width, tb)
+    pb = np.empty(16 + kv.shape[0])
+    nt = _t_breaks(mode, theta, width, tb, kv)
     sub = 1 << level
-    n_int = 5 if mode == HALF else 2
+    n_int = (5 if mode == HALF else 2) + kv.shape[0]
     halves = 1 if sym else 2
     s = math.sin(theta)
     c = math.cos(theta)
@@ -315,13 +355,13 @@ def _count_nodes(mode, theta, width, level, sym, X, nvnl=False):
             a = tb[ip] + (tb[ip + 1] - tb[ip]) * q / sub
             b = tb[ip] + (tb[ip + 1] - tb[ip]) * (q + 1) / sub
             for it in range(15):
-                k = _phi_breaks(mode, a + (b - a) * X[it], s, c, level, pb, nvnl)
+                k = _phi_breaks(mode, a + (b - a) * X[it], s, c, level, pb, nvnl, kv)
                 n += min(k - 1, n_int) * sub * 15 * halves
     return n, (nt - 1) * sub * halves
 
 
 @numba.njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract"})
-def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, nvnl=False):
+def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, nvnl, kv):
     """Fill the nodes of one incidence angle; returns the number written.
 
     wo (N, 3), wk / wg (N,) Kronrod / Gauss weights including the measure and
@@ -330,12 +370,12 @@ def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, nvn
     s = math.sin(theta)
     c = math.cos(theta)
     tb = np.empty(64)
-    nt = _t_breaks(mode, theta, width, tb)
+    nt = _t_breaks(mode, theta, width, tb, kv)
     sub = 1 << level
-    n_int = 5 if mode == HALF else 2
+    n_int = (5 if mode == HALF else 2) + kv.shape[0]
     halves = 1 if sym else 2
     fac = 2.0 if sym else 1.0
-    pb = np.empty(8)
+    pb = np.empty(16 + kv.shape[0])
     n = 0
     tp = 0
     for ip in range(nt - 1):
@@ -346,7 +386,7 @@ def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, nvn
                 t = a + (b - a) * X[it]
                 wtk = WK[it] * (b - a)
                 wtg = WG[it] * (b - a)
-                k = _phi_breaks(mode, t, s, c, level, pb, nvnl)
+                k = _phi_breaks(mode, t, s, c, level, pb, nvnl, kv)
                 st = math.sin(t)
                 ct = math.cos(t)
                 for h in range(halves):
@@ -411,13 +451,13 @@ def _reduce(vals, wk, wg, piece, n_pieces, n, C, out_a, out_e):
 
 
 def _gen_all_py(mode, thetas, width, levels, sym, X, WK, WG, offsets, wo, wk, wg, piece,
-                nvnl):
+                nvnl, kvs):
     """Nodes of every angle i at its level, written at offsets[i] (parallel over angles)."""
     for i in numba.prange(thetas.shape[0]):
         o = offsets[i]
         m = offsets[i + 1] - o
         n = _gen_nodes(mode, thetas[i], width, levels[i], sym, X, WK, WG, wo[o:o + m],
-                       wk[o:o + m], wg[o:o + m], piece[o:o + m], nvnl)
+                       wk[o:o + m], wg[o:o + m], piece[o:o + m], nvnl, kvs[i])
         for j in range(n, m):  # unused slots (absent azimuth intervals): weight 0
             wo[o + j, 0] = 0.0
             wo[o + j, 1] = 0.0
@@ -498,7 +538,7 @@ MAX_CHUNK_NODES = 3_000_000
 MAX_ANGLE_NODES = 6_000_000
 
 
-def _integrate_chunk(evaluate, th, mode, width, level, sym, nvnl, counts, npieces, a, e,
+def _integrate_chunk(evaluate, th, mode, width, level, sym, nvnl, kvs, counts, npieces, a, e,
                      idx, tol) -> np.ndarray:
     """One level for the angles ``th`` (results written to a[idx], e[idx]); returns the
     mask of angles whose error estimate is still above the goal."""
@@ -513,7 +553,8 @@ def _integrate_chunk(evaluate, th, mode, width, level, sym, nvnl, counts, npiece
     piece = np.empty(total, dtype=np.int64)
     big = total >= PARALLEL_NODES
     gen = _gen_all_parallel if big else _gen_all_serial
-    gen(mode, th, width, lv, sym, _X, _WK, _WGAUSS, offsets, wo, wk, wg, piece, nvnl)
+    gen(mode, th, width, lv, sym, _X, _WK, _WGAUSS, offsets, wo, wk, wg, piece, nvnl,
+        np.ascontiguousarray(kvs))
     vals = np.ascontiguousarray(evaluate(th, offsets, wo), dtype=np.float64)
     del wo
     aa = np.empty((th.size, vals.shape[1]))
@@ -526,12 +567,14 @@ def _integrate_chunk(evaluate, th, mode, width, level, sym, nvnl, counts, npiece
 
 
 def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool, tol: float,
-               n_channels: int, nvnl: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+               n_channels: int, nvnl: bool = False, kinks: np.ndarray | None = None
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Level loop shared by the compiled and the callable paths.
 
     ``evaluate(thetas, offsets, wo) -> vals (N, C)`` evaluates f at the nodes.
     """
     n = thetas.size
+    kvs = np.full((n, 0), np.nan) if kinks is None else np.asarray(kinks, dtype=np.float64)
     a = np.zeros((n, n_channels))
     e = np.full((n, n_channels), np.inf)
     levels = np.zeros(n, dtype=np.int64)
@@ -540,7 +583,8 @@ def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool,
         counts = np.empty(todo.size, dtype=np.int64)
         npieces = np.empty(todo.size, dtype=np.int64)
         for k, t in enumerate(thetas[todo]):
-            counts[k], npieces[k] = _count_nodes(mode, float(t), width, level, sym, _X, nvnl)
+            counts[k], npieces[k] = _count_nodes(mode, float(t), width, level, sym, _X, nvnl,
+                                                 kvs[todo[k]])
         if level > 0:
             # memory bound: an angle whose next level needs more than MAX_ANGLE_NODES keeps
             # the previous level's estimate and its (larger, honest) error estimate
@@ -558,7 +602,7 @@ def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool,
                 acc += int(counts[stop])
                 stop += 1
             idx = todo[start:stop]
-            bad = _integrate_chunk(evaluate, thetas[idx], mode, width, level, sym, nvnl,
+            bad = _integrate_chunk(evaluate, thetas[idx], mode, width, level, sym, nvnl, kvs[idx],
                                    counts[start:stop], npieces[start:stop], a, e, idx, tol)
             levels[idx] = level
             still.append(idx[bad])
@@ -622,6 +666,22 @@ def _has_nvnl_kink(model) -> bool:
         "nv=nl" in tuple(getattr(model, "albedo_kinks", ()))
 
 
+MAX_KINKS = 12
+
+
+def _declared_kinks(model, flat: np.ndarray) -> np.ndarray | None:
+    """The model's ``albedo_kinks_nv(theta) -> (T, K)`` levels k of N·V where its
+    integrand has a kink (NaN: none), or None."""
+    fn = getattr(model, "albedo_kinks_nv", None)
+    if not callable(fn):
+        return None
+    kv = np.asarray(fn(flat), dtype=np.float64).reshape(flat.size, -1)
+    if kv.shape[1] > MAX_KINKS:
+        # keep the engine's break-point arrays small: the rest is left to refinement
+        kv = kv[:, :MAX_KINKS]
+    return np.ascontiguousarray(kv)
+
+
 def _check_theta(theta_i) -> np.ndarray:
     th = np.asarray(theta_i, dtype=np.float64)
     if not np.all(np.isfinite(th)):
@@ -677,6 +737,17 @@ def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
         Models with a ``specular_albedo(theta)`` method (a delta term not in
         the kernel, e.g. He–Torrance) have it added, with no extra error.
 
+    Notes
+    -----
+    A model can declare kinks of its integrand on curves N·V = k (constant
+    θ_o, e.g. N·V = N·L for max(N·L, N·V) terms, or the levels where a pumped
+    model's g switches branch) with a method ``albedo_kinks_nv(theta) -> (T, K)``
+    giving for each θ_i up to 12 levels k (NaN for none); they become panel
+    edges in every frame (closed forms in :func:`_phi_breaks`), so the error
+    estimate stays honest. At most 6e6 nodes are used per angle
+    (``MAX_ANGLE_NODES``): an angle needing more keeps the last level's result
+    and its (larger) error estimate.
+
     Examples
     --------
     >>> import brdfkit, numpy as np
@@ -708,7 +779,7 @@ def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
             return vals
 
         a, e, _ = _integrate(evaluate, flat, m_mode, m_width, sym, tol, P.shape[0],
-                             _has_nvnl_kink(model))
+                             _has_nvnl_kink(model), _declared_kinks(model, flat))
         coloured = getattr(model, "n_channels", None) is not None
     elif callable(model):
         a, e, coloured = _albedo_callable(model, flat, m_mode, m_width, tol)
