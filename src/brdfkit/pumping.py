@@ -571,6 +571,55 @@ class PumpedBRDF(BRDF):
         a = self.table.at_cos(mu)
         return np.minimum(a, 1.0) if self.capped else a
 
+    def albedo_kinks_nv(self, theta) -> np.ndarray:
+        """Levels k of N·V = cos θ_V where f*(L, ·) has a kink, for the albedo engine.
+
+        g switches branch where two of its arguments are equal; all of them depend
+        on V only through θ_V, so every kink is a circle N·V = k: a(V) = a(L)
+        (k = cos θ_L and the other roots when a is not monotone), and for the
+        controlled g₂ also N·V = a(L), a(V) = N·L and a(V) = N·V. Earlier stages'
+        kinks are included. Returns shape (T, K), NaN where a level does not exist.
+        """
+        th = np.asarray(theta, dtype=np.float64).reshape(-1)
+        mu_l = np.cos(th)
+        grid = np.linspace(0.0, 1.0, 1025)  # cos θ_V; roots located to ~1e-3 then refined
+        a_grid = _as_2d(self._albedo_at_cos(grid))  # (M, C)
+        a_l = _as_2d(self._albedo_at_cos(mu_l))  # (T, C)
+        cols: list[np.ndarray] = [mu_l]
+
+        def roots(diff):  # diff (T, M): the crossings in cos θ_V by linear interpolation
+            sgn = np.signbit(diff)
+            out = []
+            for r in range(diff.shape[0]):
+                idx = np.nonzero(sgn[r, 1:] != sgn[r, :-1])[0][:3]
+                row = np.full(3, np.nan)
+                for q, j in enumerate(idx):
+                    d0, d1 = diff[r, j], diff[r, j + 1]
+                    row[q] = grid[j] + (grid[j + 1] - grid[j]) * d0 / (d0 - d1)
+                out.append(row)
+            return np.array(out).reshape(diff.shape[0], 3)
+
+        for ch in range(a_grid.shape[1]):
+            cols.append(roots(a_grid[None, :, ch] - a_l[:, ch:ch + 1]))
+            if self.g == "controlled":
+                cols.append(a_l[:, ch])
+                cols.append(roots(a_grid[None, :, ch] - mu_l[:, None]))
+                own = roots((a_grid[:, ch] - grid)[None, :])
+                cols.append(np.broadcast_to(own, (th.size, own.shape[1])))
+        if isinstance(self.base, PumpedBRDF) or callable(getattr(self.base, "albedo_kinks_nv",
+                                                                 None)):
+            cols.append(np.asarray(self.base.albedo_kinks_nv(th), dtype=np.float64)
+                        .reshape(th.size, -1))
+        kv = np.column_stack([np.asarray(c, dtype=np.float64).reshape(th.size, -1)
+                              for c in cols])
+        kv = np.where((kv > 0.0) & (kv < 1.0), kv, np.nan)
+        # distinct levels first (a root of a(V) = a(L) is usually cos θ_L itself)
+        kv = np.sort(np.round(kv, 12), axis=1)
+        dup = np.zeros_like(kv, dtype=bool)
+        dup[:, 1:] = np.abs(np.diff(kv, axis=1)) < 1e-9
+        kv = np.where(dup, np.nan, kv)
+        return np.sort(kv, axis=1)  # NaNs last
+
     def sample(self, wo, u):
         """The base model's sampler (the pdf is the base pdf)."""
         return self.base.sample(wo, u)
