@@ -72,6 +72,10 @@ def save_atomic(fig, path: str, *, dpi: int = 150) -> str:
     try:
         with os.fdopen(fd, "wb") as fh:
             fig.savefig(fh, format=ext, dpi=dpi, bbox_inches="tight")
+        # mkstemp creates the file with mode 0600; give it the mode a plain open() would
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
