@@ -379,8 +379,10 @@ class Microfacet(BRDF):
 
     def _d(self, cos_h: np.ndarray) -> np.ndarray:
         alpha = self._values["alpha"]
-        # clamp: avoid 0-division where D is 0 anyway (1e-100: c⁴ must not underflow to 0)
-        c = np.clip(cos_h, 1e-100, 1.0)
+        # clamp: avoid 0-division where D is 0 anyway; 1e-60 keeps π α² c⁴ ≥ 1e-248 α² from
+        # underflowing to 0 (which gave 0/0 = NaN with 1e-100), and D(1e-60) is 0 (Beckmann)
+        # or α²/π within 1e-120 relative of the true GGX value there.
+        c = np.clip(cos_h, 1e-60, 1.0)
         c2 = c * c
         tan2 = (1.0 - c2) / c2
         if self._values["distribution"] == "beckmann":
