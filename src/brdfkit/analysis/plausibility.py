@@ -234,7 +234,7 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
         a_graze = float(a[ig[1]].max())
         if a_graze < 0.5 * max_a:
             notes.append(f"dark at grazing incidence: a(89.9 deg) = {a_graze:.3g}, "
-                         f"{100 * a_graze / max_a:.0f}% of its maximum (Neumann §1.2)")
+                         f"{100 * a_graze / max_a:.2g}% of its maximum (Neumann §1.2)")
     if not asym <= RECIPROCITY_TOL:
         notes.append(f"not reciprocal: max relative asymmetry {asym:.3g}")
     if hasattr(model, "specular_albedo"):

@@ -100,9 +100,8 @@ def _row(model, label: str, lewis=None) -> dict:
             agree = False
             notes.append(f"DISAGREES with Lewis Table 2 (reciprocal: {r_claim})")
         if objection.startswith("L_r always peaks"):
-            if v.peaks_at_normal:
-                notes.append("Lewis's objection confirmed: f peaks at V = N for every incidence")
-            else:
+            # when confirmed, check()'s own note already says so (no second copy here)
+            if not v.peaks_at_normal:
                 agree = False
                 notes.append("Lewis's objection NOT confirmed numerically: f does not peak at "
                              "V = N for some incidence")
