@@ -536,6 +536,11 @@ class _MixtureSampled(BRDF):
 
     has_sampler = True
 
+    @classmethod
+    def width_from_beta(cls, beta: float) -> float:
+        """Exponent with cosⁿβ = 1/2 (Lewis §3.1): ``n``, or ``s`` in ``nielsen``."""
+        return float(exponent_from_beta(beta))
+
     def _mixture(self, wo: np.ndarray) -> tuple[list, np.ndarray]:
         """Components and weights (shape (K,) or (..., K), summing to 1) for viewer(s) *wo*."""
         raise NotImplementedError
@@ -614,10 +619,6 @@ class Phong(_MixtureSampled):
         out = [Lobe("diffuse", math.pi / 2)] if np.any(self._values["k_d"]) else []
         return out + [_lobe("mirror", self._values["n"])]
 
-    @classmethod
-    def width_from_beta(cls, beta: float) -> float:
-        return float(exponent_from_beta(beta))
-
     def _mixture(self, wo):
         v = self._values
         n = v["n"]
@@ -674,10 +675,6 @@ class Blinn(_MixtureSampled):
     def lobes(self):
         out = [Lobe("diffuse", math.pi / 2)] if np.any(self._values["k_d"]) else []
         return out + [_lobe("half", self._values["n"])]
-
-    @classmethod
-    def width_from_beta(cls, beta: float) -> float:
-        return float(exponent_from_beta(beta))
 
     def _mixture(self, wo):
         v = self._values
@@ -772,10 +769,6 @@ class PhongEnergyConserving(_MixtureSampled):
         out = [Lobe("diffuse", math.pi / 2)] if np.any(np.asarray(v["k_sigma"]) < 1.0) else []
         return out + [_lobe("mirror" if v["lobe"] == "phong" else "half", v["n"])]
 
-    @classmethod
-    def width_from_beta(cls, beta: float) -> float:
-        return float(exponent_from_beta(beta))
-
     def specular_integral(self, theta_i) -> np.ndarray:
         """H_s(θ_i) of this model's lobe and exponent (see :func:`specular_integral`)."""
         return specular_integral(theta_i, self._values["n"], self._values["lobe"])
@@ -832,10 +825,6 @@ class PhongBlinnReciprocal(_MixtureSampled):
     def lobes(self):
         out = [Lobe("diffuse", math.pi / 2)] if np.any(self._values["k_d"]) else []
         return out + [_lobe("half", self._values["n"])]
-
-    @classmethod
-    def width_from_beta(cls, beta: float) -> float:
-        return float(exponent_from_beta(beta))
 
     def _mixture(self, wo):
         v = self._values
@@ -972,10 +961,6 @@ class ModifiedBlinnPhong(_MixtureSampled):
         out = [Lobe("diffuse", math.pi / 2)] if np.any(self._values["rho_d"]) else []
         return out + [_lobe("half", self._values["n"])]
 
-    @classmethod
-    def width_from_beta(cls, beta: float) -> float:
-        return float(exponent_from_beta(beta))
-
     def _mixture(self, wo):
         v = self._values
         p_d = diffuse_fraction(v["rho_d"], v["rho_s"])
@@ -1094,10 +1079,6 @@ class Lafortune(_MixtureSampled):
             out.append(lb if kind != "diffuse" else Lobe("diffuse", lb.width))
         return out
 
-    @classmethod
-    def width_from_beta(cls, beta: float) -> float:
-        return float(exponent_from_beta(beta))
-
     def _mixture(self, wo):
         v = self.channel_values(0)
         comps = [("cosine", 0.0, None)]
@@ -1198,10 +1179,6 @@ class NeumannPhong(_MixtureSampled):
     def lobes(self):
         return [_lobe("mirror", self._values["n"])]
 
-    @classmethod
-    def width_from_beta(cls, beta: float) -> float:
-        return float(exponent_from_beta(beta))
-
     def _mixture(self, wo):
         return [("phong", self._values["n"], None)], np.array([1.0])
 
@@ -1299,10 +1276,6 @@ class Nielsen(_MixtureSampled):
         if v["alpha"] > 0.0:
             out.append(_lobe("half", 4.0 * v["s"]))
         return out
-
-    @classmethod
-    def width_from_beta(cls, beta: float) -> float:
-        return float(exponent_from_beta(beta))
 
     def _mixture(self, wo):
         v = self._values
