@@ -7,11 +7,17 @@ closed forms (a*(0) = 1 for g₁ when the albedo peaks at normal incidence;
 the Phong identity a(θ) ≥ cos θ); brute-force Gauss–Legendre quadrature; and
 the paper's qualitative statements (§3.1, §3.2), quantified.
 
-Test time: every new pumped kernel is compiled by Numba (seconds each), so
-the registry-wide theorem check pumps each reciprocal model's examples ONCE
-with each g at 4 angles, while the repeated-pumping check (1–3 stages, both
-g) uses the paper's n = 20 Phong and Blinn; 4–5 stages are covered by the
-report script, not by the unit tests.
+Coverage and test time (CI runs the whole suite in < 20 min on 2 cores, so
+this file aims at <= 90 s on a quiet machine): every new pumped kernel is
+compiled by Numba (~1 s each) and its table built with the albedo engine, so
+the registry-wide theorem check (a <= a* <= 1, reciprocity) pumps every
+reciprocal registered model's FIRST example once with g₁ and with g₂
+(He–Torrance, whose kernel is a slow series, with g₁ only) at
+θ = 0, 30, 60, 80, 89, 89.9°; other examples are the same formulas with
+other numbers. Repeated pumping (1–5 stages with g₁, 1–3 with g₂) is checked
+on the paper's n = 20 Phong (modified-phong) and Blinn
+(phong-blinn-reciprocal): these are the cases the paper plots and the ones
+whose albedo has kinks (g₂) that the tables must resolve.
 """
 
 from __future__ import annotations
@@ -75,19 +81,19 @@ def blinn():
 
 @pytest.fixture(scope="module")
 def phong_max(phong):
-    return pump_sequence(phong, "max", times=3)
+    return pump_sequence(phong, "max", times=5)
 
 
 @pytest.fixture(scope="module")
 def blinn_max(blinn):
-    return pump_sequence(blinn, "max", times=3)
+    return pump_sequence(blinn, "max", times=5)
 
 
 @pytest.fixture(scope="module")
 def blinn_ctrl(blinn):
-    # 2 stages: the table of the g2-pumped Blinn needs 512 intervals (its albedo has a
-    # kink where a(θ) crosses cos θ), ~1 min to build; stage 3 is in the report script
-    return pump_sequence(blinn, "controlled", times=2)
+    # 3 stages: the tables are split at the albedo's kinks (where a(θ) crosses cos θ),
+    # so each builds in ~1 s (test_table_split_at_kinks)
+    return pump_sequence(blinn, "controlled", times=3)
 
 
 # --------------------------------------------------------------------------- the model object
@@ -230,10 +236,31 @@ def test_engine_error_estimate_honest_with_declared_kinks(blinn_ctrl):
     assert np.all(np.abs(r.albedo - ref) <= r.error + 3e-8)
 
 
+def test_table_split_at_kinks(blinn_ctrl):
+    """Stage-k tables of the g₂-pumped Blinn (the paper's Fig. 6), whose albedo has kinks
+    where the previous table crosses cos θ: split into pieces there, each stays within
+    1e-5 of the engine (reference: the albedo engine on the base stage, independent of
+    the table) and above it (the upper-bound margin), also right next to the kinks."""
+    for k in (1, 2, 3):
+        m = blinn_ctrl[k]
+        kinks = np.arccos(np.clip(m.base.albedo_kink_mus if k > 1 else [], 0.0, 1.0)) \
+            if k > 1 else np.array([])
+        th = np.concatenate([np.radians(np.linspace(0.0, 89.9, 46)),
+                             (kinks[:, None] + np.array([-1e-4, 1e-4])).ravel()])
+        th = th[(th >= 0.0) & (th <= math.radians(89.9))]
+        ref = _alb(m.base, th)
+        tab = m.table(th)
+        assert np.max(np.abs(tab - ref)) < 1e-5
+        assert np.all(tab >= ref - 1e-7)  # 1e-7: the engine's own accuracy at tol 1e-8
+    # the stage-2 and stage-3 tables are split at the kink near 85.9° (a₀ = cos θ)
+    assert len(blinn_ctrl[2].table.piece_nn) >= 2
+    assert blinn_ctrl[3].table.n_intervals < 200
+
+
 # --------------------------------------------------------------------------- the theorem
 @pytest.mark.parametrize("which", ["phong_max", "blinn_max", "blinn_ctrl"])
 def test_theorem_repeated(which, request):
-    """a_(k-1) <= a_k <= 1 for k = 1..3 (eqs. 18-19, derived), at 0 ... 89.9 deg."""
+    """a_(k-1) <= a_k <= 1 for k = 1..5 (g₁) / 1..3 (g₂) (eqs. 18-19, derived)."""
     seq = request.getfixturevalue(which)
     prev = _alb(seq[0], TH_CHECK)
     for k in range(1, len(seq)):
@@ -248,7 +275,7 @@ def test_g1_normal_incidence_albedo_is_one(phong_max, blinn_max):
     for seq in (phong_max, blinn_max):
         a0 = _alb(seq[0], np.radians(np.linspace(0, 89.9, 30)))
         assert np.argmax(a0) == 0  # albedo peaks at normal incidence
-        for k in (1, 2, 3):
+        for k in range(1, len(seq)):
             assert _alb(seq[k], [0.0])[0] == pytest.approx(1.0, abs=1e-5)
 
 
@@ -258,23 +285,20 @@ SLOW_MODELS = {"he-torrance"}
 
 
 def _reciprocal_cases():
-    # g1 for every example, g2 for the first (typical) one: each (model, g) compiles a kernel
+    # the first (typical) example with g1 and g2: each (model, g) compiles a kernel
     for name, cls in brdfkit.MODELS.items():
-        if not cls.reciprocal:
+        if not cls.reciprocal or not cls.examples:
             continue
-        for i, ex in enumerate(cls.examples):
-            if name in SLOW_MODELS and i > 0:
-                continue
-            gs = ("max", "controlled") if i == 0 and name not in SLOW_MODELS else ("max",)
-            for g in gs:
-                yield pytest.param(name, ex, g, id=f"{name}-{i}-{g}")
+        gs = ("max",) if name in SLOW_MODELS else ("max", "controlled")
+        for g in gs:
+            yield pytest.param(name, cls.examples[0], g, id=f"{name}-0-{g}")
 
 
 @pytest.mark.parametrize("name,params,g", list(_reciprocal_cases()))
 def test_theorem_registry(name, params, g):
-    """Every registered reciprocal model × example, pumped once: a <= a* <= 1 at 4 angles."""
+    """Every registered reciprocal model (first example), pumped once: a <= a* <= 1."""
     base = brdfkit.model(name, **params)
-    th = np.radians([0.0, 45.0, 80.0, 89.9])
+    th = TH_CHECK
     a = _alb(base, th)
     with warnings.catch_warnings(record=True) as rec:
         warnings.simplefilter("always")
@@ -319,7 +343,9 @@ def test_g2_equals_g1_for_normalised_phong(phong, phong_max):
     c2 = pump_sequence(phong, "controlled", times=2)
     wi, wo = _random_pairs(200, 8)
     for k in (1, 2):
-        np.testing.assert_allclose(c2[k].eval(wi, wo), phong_max[k].eval(wi, wo), rtol=1e-12)
+        # rtol 1e-7: equal functions, but g2's stage-2 table is split where a(θ) touches
+        # cos θ (declared kinks), so the two splines differ within the table accuracy
+        np.testing.assert_allclose(c2[k].eval(wi, wo), phong_max[k].eval(wi, wo), rtol=1e-7)
 
 
 def test_g2_differs_for_blinn(blinn, blinn_max, blinn_ctrl):

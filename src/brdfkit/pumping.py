@@ -93,7 +93,13 @@ over θ ∈ [0, 89.9°] — linear in θ at normal incidence, dense near grazing
 where sharp lobes are cut by the horizon (see :class:`AlbedoTable`) — and
 interpolates with a cubic spline. The grid is doubled until the spline,
 checked against the engine at every interval midpoint, is within
-``INTERP_TOL`` there. The stored table is
+``INTERP_TOL`` there. A pumped stage's albedo has kinks (for g₂: where the
+previous table a(θ) crosses cos θ, since g switches from a(L) to N·L for all
+V at once; the base's kinks carry over): :class:`PumpedBRDF` lists them in
+``albedo_kink_mus`` and the next table is split there into pieces, each with
+its own uniform grid and spline, so no interval straddles a kink (the
+controlled Blinn n = 20 stage-3 table needs 54 intervals instead of > 512,
+and builds in seconds); the lookup scans the few piece starts, still O(1). The stored table is
 the spline **plus** a margin δ = 2 × (largest midpoint error) + ``ENGINE_ERR``
 (5e-7), so it is an upper bound of the albedo and g ≥ a(L) holds — the
 theorem's only requirement — in spite of rounding: a* ≤ 1 with no tolerance.
@@ -181,19 +187,30 @@ class PumpingWarning(UserWarning):
 
 # --------------------------------------------------------------------------- albedo table
 @numba.njit(cache=True, inline="always")
-def _table_lookup(p, off, nn, s_top, mu):  # pragma: no cover - compiled
-    """Albedo at cos θ = mu from the spline stored at p[off : off + 4 nn]."""
+def _table_lookup(p, off, mu):  # pragma: no cover - compiled
+    """Albedo at cos θ = mu from the piecewise spline table stored at p[off:].
+
+    Layout: m (number of pieces), then per piece (start w, intervals per unit w,
+    first interval index, intervals), then 4 coefficients per interval. The pieces
+    split [w(THETA_TOP), 1] at the albedo's kinks; each is uniform in w.
+    """
     # w = sqrt(1 - sqrt(1 - mu)), see AlbedoTable; clamp: |wi| = 1 up to rounding
     r = 1.0 - mu
     w = math.sqrt(1.0 - math.sqrt(r)) if r > 0.0 else 1.0
-    x = (w - s_top) / (1.0 - s_top) * nn
+    m = int(p[off])
+    i = 0
+    while i < m - 1 and w >= p[off + 1 + 4 * (i + 1)]:
+        i += 1  # at most a few pieces: a short scan
+    d = off + 1 + 4 * i
+    nn = int(p[d + 3])
+    x = (w - p[d]) * p[d + 1]
     if x < 0.0:
         x = 0.0  # beyond THETA_TOP: hold the last tabulated value (see module docstring)
     j = int(x)
     if j >= nn:
         j = nn - 1  # mu = 1 (normal incidence) or 1 + rounding: last interval
     t = x - j
-    b = off + 4 * j
+    b = off + 1 + 4 * m + 4 * (int(p[d + 2]) + j)
     return ((p[b] * t + p[b + 1]) * t + p[b + 2]) * t + p[b + 3]
 
 
@@ -205,7 +222,14 @@ class AlbedoTable:
     ----------
     coeffs : ndarray, shape (C, nn, 4)
         Per-interval cubic coefficients in the local variable t ∈ [0, 1]
-        (highest power first), the margin ``delta`` already added.
+        (highest power first), the margin ``delta`` already added; the
+        intervals of all pieces, in order of w.
+    breaks : ndarray, shape (m + 1,)
+        Piece boundaries in w (``s_top`` … 1): the table is split at the
+        albedo's kinks (the model's ``albedo_kink_mus``), with its own uniform
+        grid and spline on each piece, so a kink never lies inside an interval.
+    piece_nn : tuple of int
+        Intervals of each piece.
     s_top : float
         w(THETA_TOP): the grid is uniform in w = √(1 − √(1 − cos θ)) on
         [s_top, 1]. This variable is linear in θ at normal incidence (where
@@ -232,6 +256,8 @@ class AlbedoTable:
 
     coeffs: np.ndarray
     s_top: float
+    breaks: np.ndarray
+    piece_nn: tuple
     max_midpoint_error: np.ndarray
     delta: np.ndarray
     max_albedo: np.ndarray
@@ -247,7 +273,13 @@ class AlbedoTable:
 
     def packed(self, c: int) -> np.ndarray:
         """Channel *c*'s coefficients flattened for the kernel."""
-        return np.ascontiguousarray(self.coeffs[c].reshape(-1))
+        m = len(self.piece_nn)
+        d = []
+        cum = 0
+        for i, nn in enumerate(self.piece_nn):
+            d += [self.breaks[i], nn / (self.breaks[i + 1] - self.breaks[i]), cum, nn]
+            cum += nn
+        return np.ascontiguousarray(np.concatenate([[float(m)], d, self.coeffs[c].reshape(-1)]))
 
     def __call__(self, theta) -> np.ndarray:
         """Tabulated albedo (an upper bound) at incidence angles *theta* (radians).
@@ -259,11 +291,14 @@ class AlbedoTable:
     def at_cos(self, mu) -> np.ndarray:
         """Tabulated albedo at cos θ = *mu* (vectorised :func:`_table_lookup`)."""
         mu = np.asarray(mu, dtype=np.float64)
-        nn = self.n_intervals
         w = _w_of_mu(mu)
-        x = np.maximum((w - self.s_top) / (1.0 - self.s_top) * nn, 0.0)
-        j = np.minimum(x.astype(np.int64), nn - 1)
+        nns = np.array(self.piece_nn)
+        i = np.clip(np.searchsorted(self.breaks[1:-1], w, side="right"), 0, nns.size - 1)
+        start = self.breaks[i]
+        x = np.maximum((w - start) * (nns[i] / (self.breaks[i + 1] - start)), 0.0)
+        j = np.minimum(x.astype(np.int64), nns[i] - 1)
         t = (x - j)[..., None]
+        j = j + np.concatenate([[0], np.cumsum(nns)[:-1]])[i]
         c = self.coeffs[:, j, :]  # (C, ..., 4)
         c = np.moveaxis(c, 0, -2)  # (..., C, 4)
         out = ((c[..., 0] * t + c[..., 1]) * t + c[..., 2]) * t + c[..., 3]
@@ -287,7 +322,7 @@ def _engine(model) -> Callable:
 
 
 def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
-                       nn_max: int = 8192) -> AlbedoTable:
+                       nn_max: int = 8192, kinks_mu=None) -> AlbedoTable:
     """Tabulate the albedo of *model* to interpolation tolerance *tol*.
 
     Parameters
@@ -298,7 +333,12 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
         Largest allowed |spline − engine| at the interval midpoints (relative
         to max(1, a) where the albedo exceeds 1).
     nn_start, nn_max : int, keyword-only
-        First and largest number of intervals; the grid doubles in between.
+        First and largest number of intervals (of the whole range; each piece
+        gets its share); the grid of each piece doubles in between.
+    kinks_mu : sequence of float, keyword-only
+        cos θ where the albedo has a kink; default ``model.albedo_kink_mus``
+        (pumped models declare them). The table is split there into pieces
+        with their own splines.
 
     Returns
     -------
@@ -314,48 +354,66 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
         raise ParameterError(f"build_albedo_table: tol must lie in (0, 1); got {tol!r}")
     run = _engine(model)
     s_top = float(_w_of_mu(math.cos(THETA_TOP)))
+    if kinks_mu is None:
+        kinks_mu = getattr(model, "albedo_kink_mus", ())
+    kw = np.sort(_w_of_mu(np.asarray(kinks_mu, dtype=np.float64).reshape(-1)))
+    breaks = [s_top]
+    for x in kw:  # pieces at least 1e-3 wide in w (closer kinks: one piece, refined)
+        if x - breaks[-1] > 1e-3 and 1.0 - x > 1e-3:
+            breaks.append(float(x))
+    breaks.append(1.0)
+    breaks = np.array(breaks)
 
     def thetas(w):
         return np.arccos(np.clip(1.0 - (1.0 - w * w) ** 2, 0.0, 1.0))
 
-    nn = int(nn_start)
-    s_nodes = np.linspace(s_top, 1.0, nn + 1)
-    vals = _as_2d(run(thetas(s_nodes)))
-    n_eval = len(s_nodes)
-    while True:
-        s_mid = 0.5 * (s_nodes[:-1] + s_nodes[1:])
-        mid = _as_2d(run(thetas(s_mid)))
-        n_eval += len(s_mid)
-        if not (np.all(np.isfinite(vals)) and np.all(np.isfinite(mid))):
-            raise BrdfkitError(f"pumping: the albedo of {_label(model)} is not finite on "
-                               "[0, 89.9] deg; it cannot be tabulated")
-        coeffs = _spline_coeffs(s_nodes, vals)  # (C, nn, 4) in t
-        interp = _eval_coeffs(coeffs, np.full(nn, 0.5))  # (nn, C) at the midpoints
-        err = np.abs(interp - mid) / np.maximum(1.0, np.abs(mid))
-        if np.all(err.max(axis=0) <= tol):
-            break
-        if 2 * nn > nn_max:
-            worst = int(np.argmax(err.max(axis=1)))
-            raise BrdfkitError(
-                f"pumping: could not tabulate the albedo of {_label(model)} to {tol:g} with "
-                f"{nn_max} intervals (error {err.max():.3g} at theta = "
-                f"{math.degrees(thetas(s_mid[worst])):.4f} deg)")
-        # the midpoints become nodes of the doubled grid
-        merged = np.empty((2 * nn + 1, vals.shape[1]))
-        merged[0::2] = vals
-        merged[1::2] = mid
-        vals = merged
-        nn *= 2
-        s_nodes = np.linspace(s_top, 1.0, nn + 1)
-    max_err = (np.abs(interp - mid)).max(axis=0)
+    n_eval = 0
+    all_coeffs, all_nodes, piece_nn, max_errs, maxes = [], [], [], [], []
+    for lo, hi in zip(breaks[:-1], breaks[1:]):
+        nn = max(4, int(round(nn_start * (hi - lo) / (1.0 - s_top))))
+        s_nodes = np.linspace(lo, hi, nn + 1)
+        vals = _as_2d(run(thetas(s_nodes)))
+        n_eval += len(s_nodes)
+        while True:
+            s_mid = 0.5 * (s_nodes[:-1] + s_nodes[1:])
+            mid = _as_2d(run(thetas(s_mid)))
+            n_eval += len(s_mid)
+            if not (np.all(np.isfinite(vals)) and np.all(np.isfinite(mid))):
+                raise BrdfkitError(f"pumping: the albedo of {_label(model)} is not finite on "
+                                   "[0, 89.9] deg; it cannot be tabulated")
+            coeffs = _spline_coeffs(s_nodes, vals, zero_slope_end=hi == 1.0)
+            interp = _eval_coeffs(coeffs, np.full(nn, 0.5))  # (nn, C) at the midpoints
+            err = np.abs(interp - mid) / np.maximum(1.0, np.abs(mid))
+            if np.all(err.max(axis=0) <= tol):
+                break
+            if 2 * nn > nn_max:
+                worst = int(np.argmax(err.max(axis=1)))
+                raise BrdfkitError(
+                    f"pumping: could not tabulate the albedo of {_label(model)} to {tol:g} "
+                    f"with {nn_max} intervals (error {err.max():.3g} at theta = "
+                    f"{math.degrees(thetas(s_mid[worst])):.4f} deg)")
+            # the midpoints become nodes of the doubled grid
+            merged = np.empty((2 * nn + 1, vals.shape[1]))
+            merged[0::2] = vals
+            merged[1::2] = mid
+            vals = merged
+            nn *= 2
+            s_nodes = np.linspace(lo, hi, nn + 1)
+        all_coeffs.append(coeffs)
+        all_nodes.append(s_nodes if not all_nodes else s_nodes[1:])
+        piece_nn.append(nn)
+        max_errs.append(np.abs(interp - mid).max(axis=0))
+        maxes.append(np.maximum(vals.max(axis=0), mid.max(axis=0)))
+    max_err = np.max(max_errs, axis=0)
     delta = 2.0 * max_err + ENGINE_ERR
-    coeffs = coeffs.copy()
+    coeffs = np.concatenate(all_coeffs, axis=1)
     coeffs[:, :, 3] += delta[:, None]
     coloured = getattr(model, "n_channels", None) is not None
-    return AlbedoTable(coeffs=coeffs, s_top=s_top, max_midpoint_error=max_err, delta=delta,
-                       max_albedo=np.maximum(vals.max(axis=0), mid.max(axis=0)),
-                       theta_nodes=thetas(s_nodes), n_evaluations=n_eval, coloured=coloured,
-                       nondecreasing=_nondecreasing(coeffs))
+    return AlbedoTable(coeffs=coeffs, s_top=s_top, breaks=breaks, piece_nn=tuple(piece_nn),
+                       max_midpoint_error=max_err, delta=delta,
+                       max_albedo=np.max(maxes, axis=0),
+                       theta_nodes=thetas(np.concatenate(all_nodes)), n_evaluations=n_eval,
+                       coloured=coloured, nondecreasing=_nondecreasing(coeffs))
 
 
 def _w_of_mu(mu) -> np.ndarray:
@@ -381,17 +439,20 @@ def _as_2d(a: np.ndarray) -> np.ndarray:
     return a[:, None] if a.ndim == 1 else a
 
 
-def _spline_coeffs(s: np.ndarray, vals: np.ndarray) -> np.ndarray:
+def _spline_coeffs(s: np.ndarray, vals: np.ndarray, *, zero_slope_end: bool = True
+                   ) -> np.ndarray:
     """Cubic spline through (s, vals[:, c]) as (C, nn, 4) coefficients in t.
 
-    Not-a-knot at grazing; zero slope at normal incidence (s = 1), where the
-    albedo of an isotropic model is an even function of θ and w is linear in θ.
+    Not-a-knot at grazing and at kinks; zero slope at normal incidence (s = 1),
+    where the albedo of an isotropic model is an even function of θ and w is
+    linear in θ.
     """
     from scipy.interpolate import CubicSpline
 
     h = s[1] - s[0]
     zero = np.zeros(vals.shape[1])
-    cs = CubicSpline(s, vals, axis=0, bc_type=("not-a-knot", (1, zero)))
+    bc = ("not-a-knot", (1, zero)) if zero_slope_end else "not-a-knot"
+    cs = CubicSpline(s, vals, axis=0, bc_type=bc)
     c = cs.c  # (4, nn, C) in powers of (s - s_j), highest first
     scale = np.array([h**3, h**2, h, 1.0])[:, None, None]
     return np.ascontiguousarray(np.transpose(c * scale, (2, 1, 0)))
@@ -415,7 +476,7 @@ def _pumped_kernel(base_kernel, g_code: int):
     """The compiled kernel f/g for *base_kernel* and built-in g (cached).
 
     Packed parameters of one channel (``p``), from the left: the base's
-    parameters (K values), the spline coefficients (4 nn), then the header
+    parameters (K values), the table (see :func:`_table_lookup`), then the header
     ``[monotone, cap, s_top, nn, K]`` read from the right — so the layout nests and a
     pumped kernel can be pumped again.
     """
@@ -433,15 +494,13 @@ def _pumped_kernel(base_kernel, g_code: int):
         f = base_kernel(ix, iy, iz, ox, oy, oz, p[:k])
         if f == 0.0:
             return 0.0  # nothing to pump (outside the lobe): skip the lookups
-        nn = int(p[m - 2])
-        s_top = p[m - 3]
         if p[m - 5] != 0.0:
             # the tabulated albedo is non-decreasing in cos θ (checked at build time), so
             # max(a(L), a(V)) = a(max(N·L, N·V)): one lookup instead of two
-            g = _table_lookup(p, k, nn, s_top, iz if iz > oz else oz)
+            g = _table_lookup(p, k, iz if iz > oz else oz)
         else:
-            a_i = _table_lookup(p, k, nn, s_top, iz)
-            a_o = _table_lookup(p, k, nn, s_top, oz)
+            a_i = _table_lookup(p, k, iz)
+            a_o = _table_lookup(p, k, oz)
             g = a_i if a_i > a_o else a_o
         if controlled:
             if iz > g:
@@ -535,6 +594,29 @@ class PumpedBRDF(BRDF):
         else:
             self.kernel = None
         self._packed = self._pack()
+        self.albedo_kink_mus = self._kink_mus()
+
+    def _kink_mus(self) -> tuple:
+        """cos θ_L where this stage's albedo a*(θ_L) has a kink (for the next table).
+
+        A branch switch of g that happens for every V at once as L moves makes a
+        kink in a*(L): for g₂ where the tabulated a(L) crosses N·L = cos θ_L.
+        Switches between a(L) and a(V) or N·V sweep over V smoothly and leave a*
+        smooth. The base's kinks carry over (g uses a(L)).
+        """
+        from scipy.optimize import brentq
+
+        out = list(getattr(self.base, "albedo_kink_mus", ()))
+        if self.g == "controlled":
+            grid = np.linspace(1e-6, 1.0, 2049)
+            d = _as_2d(self._albedo_at_cos(grid)) - grid[:, None]
+            for ch in range(d.shape[1]):
+                sg = np.signbit(d[:, ch])
+                for j in np.nonzero(sg[1:] != sg[:-1])[0]:
+                    out.append(brentq(lambda m, ch=ch: float(_as_2d(
+                        self._albedo_at_cos(np.array([m])))[0, ch] - m),
+                        grid[j], grid[j + 1], xtol=1e-14))
+        return tuple(sorted(set(round(float(m), 14) for m in out)))
 
     # ---------------------------------------------------------------- packing
     def _pack(self) -> np.ndarray:
