@@ -225,7 +225,7 @@ def main(argv=None) -> int:
         numba.set_num_threads(args.threads)
     n = args.pairs
     wi, wo = random_pairs(n, args.seed)
-    print("load average (1, 5, 15 min): %.2f %.2f %.2f" % os.getloadavg())
+    print("load average (1, 5, 15 min): {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     print(f"brdfkit {brdfkit.__version__}, NumPy {np.__version__}, Numba {numba.__version__} "
           f"({numba.get_num_threads()} threads), {os.cpu_count()} CPUs; {n:,} pairs, "
           f"median of {args.repeats} after a warm-up")
@@ -291,7 +291,7 @@ def main(argv=None) -> int:
         print(f"| {impl:<20} | {name:<16} | {rate / 1e6:9.1f} | {1e9 / rate:7.1f} | {t:8.3f} | "
               f"{r:>15} |")
     print()
-    print("load average (1, 5, 15 min): %.2f %.2f %.2f" % os.getloadavg())
+    print("load average (1, 5, 15 min): {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     for c in checks:
         print("check:", c)
     if note:

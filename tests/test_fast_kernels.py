@@ -73,7 +73,7 @@ def test_smith_g1_wrapper_matches_exact_form():
 def _walter_reference(wi, wo, alpha):
     """Walter eq. (20) with F = 1, factor by factor (unit half vector, D eq. 25, G₁ eq. 27)."""
     out = np.zeros(len(wi))
-    for j, (l, v) in enumerate(zip(wi, wo)):
+    for j, (l, v) in enumerate(zip(wi, wo, strict=True)):
         if l[2] <= 0.0 or v[2] <= 0.0:
             continue
         h = (l + v) / np.linalg.norm(l + v)
@@ -100,7 +100,8 @@ def test_microfacet_fast_path_matches_factorwise_formula(alpha):
         return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
 
     wi, wo = hemi(), hemi()
-    wo[: n // 4] = wi[: n // 4] * [-1.0, -1.0, 1.0] + rng.normal(0, 0.02, (n // 4, 3))  # near mirror
+    # the first quarter near the mirror direction
+    wo[: n // 4] = wi[: n // 4] * [-1.0, -1.0, 1.0] + rng.normal(0, 0.02, (n // 4, 3))
     wo /= np.linalg.norm(wo, axis=-1, keepdims=True)
     wo[:, 2] = np.abs(wo[:, 2])
     got = brdfkit.model("microfacet", alpha=alpha).eval(wi, wo)

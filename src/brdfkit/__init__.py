@@ -46,7 +46,7 @@ References
 """
 
 from brdfkit.errors import BrdfkitError, ParameterError, UnknownModelError
-from brdfkit.models import MODELS, BRDF, Param, model, model_names
+from brdfkit.models import BRDF, MODELS, Param, model, model_names
 
 __all__ = [
     "BRDF",
