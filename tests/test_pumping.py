@@ -112,10 +112,10 @@ def test_pumped_is_a_model(phong, phong_max):
 
 
 def test_with_params_repumps(phong_max):
-    q = phong_max[2].with_params(n=50.0)
-    assert isinstance(q, PumpedBRDF) and q.stages == ["max", "max"]
+    q = phong_max[1].with_params(n=50.0)
+    assert isinstance(q, PumpedBRDF) and q.stages == ["max"]
     assert q.values["n"] == 50.0
-    ref = pump(brdfkit.model("modified-phong", rho_d=0.0, rho_s=1.0, n=50.0), "max", times=2)
+    ref = pump(brdfkit.model("modified-phong", rho_d=0.0, rho_s=1.0, n=50.0), "max")
     wi, wo = _random_pairs(50, 2)
     np.testing.assert_allclose(q.eval(wi, wo), ref.eval(wi, wo), rtol=1e-12)
 
@@ -173,7 +173,7 @@ def test_engine_on_pumped_stage(phong_max):
 
     model = phong_max[1]
 
-    def brute(theta, n=600):
+    def brute(theta, n=400):
         L = _dirs(theta)
         R = L * np.array([-1.0, -1.0, 1.0])
         e1 = np.array([R[2], 0.0, -R[0]])
@@ -193,7 +193,7 @@ def test_engine_on_pumped_stage(phong_max):
             total += 2.0 * np.sum(val * (np.sin(T) * wt[:, None]) * wph[None, :])
         return total
 
-    th = np.radians([5.0, 40.0, 75.0])
+    th = np.radians([5.0, 75.0])
     ref = np.array([brute(t) for t in th])
     np.testing.assert_allclose(_alb(model, th), ref, atol=5e-7)
 
