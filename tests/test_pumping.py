@@ -181,7 +181,7 @@ def test_engine_on_pumped_stage(phong_max):
         x, w = leggauss(n)
         total = 0.0
         edges = [0.0, 0.05, 0.1, 0.2, 0.4, 0.8, 1.6, math.pi]
-        for a, b in zip(edges[:-1], edges[1:]):
+        for a, b in zip(edges[:-1], edges[1:], strict=True):
             t = 0.5 * (b - a) * x + 0.5 * (a + b)
             wt = 0.5 * (b - a) * w
             ph = 0.5 * math.pi * (x + 1.0)
@@ -211,8 +211,8 @@ def _normal_frame_albedo(model, theta, n_panels=384, n_gl=32):
     to = (te[:-1, None] + np.diff(te)[:, None] * (xs + 1) / 2).ravel()
     wt = (np.diff(te)[:, None] * ws / 2).ravel()
     pe = [0.0, 0.05, 0.15, 0.4, 1.0, math.pi / 2, 2.2, math.pi]
-    po = np.concatenate([a + (b - a) * (xp + 1) / 2 for a, b in zip(pe[:-1], pe[1:])])
-    wpp = np.concatenate([wp * (b - a) / 2 for a, b in zip(pe[:-1], pe[1:])])
+    po = np.concatenate([a + (b - a) * (xp + 1) / 2 for a, b in zip(pe[:-1], pe[1:], strict=True)])
+    wpp = np.concatenate([wp * (b - a) / 2 for a, b in zip(pe[:-1], pe[1:], strict=True)])
     total = 0.0
     L = _dirs(theta)
     for i in range(0, to.size, 512):

@@ -368,7 +368,7 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
 
     n_eval = 0
     all_coeffs, all_nodes, piece_nn, max_errs, maxes = [], [], [], [], []
-    for lo, hi in zip(breaks[:-1], breaks[1:]):
+    for lo, hi in zip(breaks[:-1], breaks[1:], strict=True):
         nn = max(4, int(round(nn_start * (hi - lo) / (1.0 - s_top))))
         s_nodes = np.linspace(lo, hi, nn + 1)
         vals = _as_2d(run(thetas(s_nodes)))
