@@ -10,10 +10,14 @@ One module per family; every model is registered in :data:`MODELS`.
   He–Torrance and the modern Walter et al. microfacet model.
 """
 
-# Importing the family modules registers their models.
-from brdfkit.models import diffuse, microfacet, phong  # noqa: E402,F401,I001
 from brdfkit.models._base import BRDF, Lobe, Param, eval_pairs
 from brdfkit.models._registry import MODELS, model, model_names, register, resolve
+
+# Importing the family modules registers their models, in this order: the order of
+# `brdfkit models`, of the README's model table and of Table 2.
+# isort: off
+from brdfkit.models import diffuse, phong, microfacet  # noqa: E402,F401
+# isort: on
 
 __all__ = ["BRDF", "Lobe", "MODELS", "Param", "eval_pairs", "model", "model_names", "register",
            "resolve"]
