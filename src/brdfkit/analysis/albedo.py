@@ -484,11 +484,10 @@ _reduce_all_parallel = numba.njit(cache=True, parallel=True)(_reduce_all_py)
 PARALLEL_NODES = 2_000_000
 
 
-# Not cached: Numba cannot reliably cache functions that take another compiled
-# function as an argument (the cache index pickles the dispatcher's type, and
-# loading it in a later process fails with "underlying object has vanished").
-# Serial: compiles in ~0.3 s per model instead of ~1 s (this matters for
-# Table 2, which compiles it for every registered model).
+# Not cached: a specialisation is keyed on the kernel's dispatcher, new in every
+# process, so an on-disk entry is never reused (same reason as models.eval_pairs).
+# Serial: compiles in ~0.3 s per model instead of ~1 s for a prange loop (this
+# matters for Table 2, which compiles it for every registered model).
 @numba.njit
 def _eval_kernel(kernel, P, thetas, offsets, wo, vals):  # pragma: no cover - compiled
     """vals[j, c] = kernel(ω_i(θ of j), wo[j], P[c]); NaN/inf replaced by 0."""
@@ -505,8 +504,10 @@ def _eval_kernel(kernel, P, thetas, offsets, wo, vals):  # pragma: no cover - co
 
 
 @numba.njit
-def _eval_pairs_uncached(kernel, wi, wo, P, out):  # pragma: no cover - compiled
-    """Like :func:`brdfkit.models.eval_pairs`, but never cached (see :func:`_eval_kernel`)."""
+def _eval_pairs_guarded(kernel, wi, wo, P, out):  # pragma: no cover - compiled
+    """:func:`brdfkit.models.eval_pairs` for the integrator: serial (cheaper to compile,
+    see :func:`_eval_kernel`) and with NaN/inf replaced by 0, so one bad node of a user
+    callable cannot poison a whole albedo."""
     for j in range(wi.shape[0]):
         for ch in range(P.shape[0]):
             v = kernel(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2], P[ch])
@@ -524,7 +525,7 @@ def evaluate_pairs(model, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
     if _is_compiled(model):
         P = np.ascontiguousarray(np.asarray(model.packed, dtype=np.float64))
         out = np.empty((wi.shape[0], P.shape[0]))
-        _eval_pairs_uncached(model.kernel, wi, wo, P, out)
+        _eval_pairs_guarded(model.kernel, wi, wo, P, out)
         return out
     return np.asarray(model(wi, wo), dtype=np.float64).reshape(wi.shape[0], -1)
 
