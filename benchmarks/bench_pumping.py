@@ -10,7 +10,8 @@ Prints, side by side with the base model:
    base: target ≤ 1.3×. Two pair sets: uniform on the hemisphere (most pairs
    miss a sharp lobe, where the pumped kernel skips its table lookups) and
    "in the lobe" (wo within ~3 lobe widths of the mirror of wi, every pair
-   pays for the lookups).
+   pays for the lookups). The models are timed in turn, repeatedly, and the
+   medians compared (a drift of the machine's speed hits all alike).
 
 Run: ``.venv/bin/python benchmarks/bench_pumping.py [--pairs N] [--repeats R]``.
 The machine should be otherwise idle (the kernels use every core).
@@ -77,11 +78,17 @@ def main(argv=None):
         width = float(brdfkit.halfangle.beta_from_exponent(n))
         for label, lw in (("uniform", None), ("in-lobe", width)):
             wi, wo = _pairs(args.pairs, rng, lw)
-            t_base = None
-            for name, m in stages:
+            for _, m in stages:
                 m.eval(wi[:1000], wo[:1000])  # compile
-                t = _median_time(lambda m=m: m.eval(wi, wo), args.repeats)
-                t_base = t if t_base is None else t_base
+            # interleaved (base, 1x, 2x, base, ...) so that drifts of the machine's speed
+            # hit every model alike; medians per model
+            times = {name: [] for name, _ in stages}
+            for _ in range(args.repeats):
+                for name, m in stages:
+                    times[name].append(_median_time(lambda m=m, wi=wi, wo=wo: m.eval(wi, wo), 1))
+            t_base = statistics.median(times["base"])
+            for name, _ in stages:
+                t = statistics.median(times[name])
                 ratio = t / t_base
                 flag = "" if name == "base" else ("  OK" if ratio <= 1.3 else "  MISSED")
                 print(f"   {f'n={n:g} ' + name:34s} {label:9s} {t * 1e3:10.1f} "

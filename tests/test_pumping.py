@@ -33,8 +33,10 @@ from brdfkit.analysis import albedo
 from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
 from brdfkit.pumping import (
+    LUT_TOL,
     PumpedBRDF,
     PumpingWarning,
+    build_lookup,
     from_dict,
     mirror_radiance,
     pump,
@@ -257,6 +259,98 @@ def test_table_split_at_kinks(blinn_ctrl):
     assert blinn_ctrl[3].table.n_intervals < 200
 
 
+# --------------------------------------------------------------------------- evaluation lookup
+def _kinked(mu):
+    # closed form with a kink at mu = 0.3 (slope jump 2) and a sharp rise near grazing
+    mu = np.asarray(mu, dtype=float)
+    return (1.0 + np.abs(mu - 0.3) + 0.5 * np.exp(-mu / 0.01))[:, None]
+
+
+@pytest.mark.parametrize("bound", ["upper", "lower"])
+def test_lookup_accuracy_bound_and_kink_anchoring(bound):
+    """Lookup vs a closed form at 2e5 random points: within 3 LUT_TOL, on the requested side;
+    a declared kink is a grid node (no refinement), an undeclared one costs intervals."""
+    lk = build_lookup(_kinked, kinks=[0.3], bound=bound)
+    mu = np.random.default_rng(1).uniform(0.0, 1.0, 200_000)
+    exact = _kinked(mu)[:, 0]
+    got = lk(mu)[:, 0]
+    rel = (got - exact) / exact
+    assert np.max(np.abs(rel)) <= 3 * LUT_TOL
+    # from the requested side, up to rounding (the margin is verified at check points only)
+    assert (np.min(rel) >= -1e-12) if bound == "upper" else (np.max(rel) <= 1e-12)
+    assert abs(lk(np.array([0.3]))[0, 0] / 1.0 - 1.0) <= 3 * LUT_TOL  # the kink value itself
+    blind = build_lookup(_kinked, kinks=[], bound=bound)
+    assert lk.n_intervals < blind.n_intervals / 2
+    assert blind.max_error > 0.0 and lk.epsilon <= 2 * max(lk.max_error, 1e-15) + 1e-14
+
+
+def test_lookup_kernel_matches_numpy_and_is_memory_safe():
+    """The compiled _lookup and Lookup.__call__ agree bit for bit on [0, 1], and clamp
+    outside it (unnormalised or NaN cosines never index outside the table)."""
+    import numba
+
+    from brdfkit.pumping import _lookup
+
+    lk = build_lookup(_kinked, kinks=[0.3])
+    p = np.concatenate([[7.0, 8.0], lk.packed(0)])  # the lookup at an offset, as in a row
+
+    @numba.njit
+    def run(p, mus):
+        out = np.empty(mus.size)
+        for i in range(mus.size):
+            out[i] = _lookup(p, 2, mus[i])
+        return out
+
+    mu = np.r_[np.linspace(0.0, 1.0, 10_001), np.nextafter(1.0, 2.0)]
+    np.testing.assert_array_equal(run(p, mu), lk(mu)[:, 0])
+    edge = run(p, np.array([1.0, 1.5, 1e300, -0.5, np.nan]))
+    assert edge[1] == edge[2] == edge[0] and edge[3] == edge[4] == run(p, np.array([0.0]))[0]
+
+
+def _f_over_g_definition(model, wi, wo):
+    """f_root / ∏ g_k from each stage's own albedo table (eqs. 16, 20, 21 stage by stage):
+    the reference for the one-lookup chain kernel."""
+    stages = []
+    node = model
+    while isinstance(node, PumpedBRDF):
+        stages.append(node)
+        node = node.base
+    f = node.eval(wi, wo)
+    for st in reversed(stages):
+        g = np.maximum(st._albedo_at_cos(wi[:, 2]), st._albedo_at_cos(wo[:, 2]))
+        if st.g == "controlled":
+            g = np.maximum(g, np.maximum(wi[:, 2], wo[:, 2]))
+        f = f / g
+    return f
+
+
+@pytest.mark.parametrize("which,chained", [
+    # stage 5 tabulates the 4x-pumped Phong, whose albedo has a real dip (6e-5 at 25 deg)
+    ("phong_max", [True, True, True, True, False]),
+    ("blinn_ctrl", [True, True, True]),
+    # Cook-Torrance's albedo rises toward grazing (Fresnel): every stage has two lookups
+    ("cook_torrance_ctrl", [False, False]),
+])
+def test_chain_kernel_is_the_stagewise_definition(which, chained, request):
+    """Monotone stages collapse to f·q(max(N·L, N·V)) with one lookup; a non-monotone stage
+    wraps the previous kernel with two lookups. Either way the kernel equals the
+    stage-by-stage definition within the lookup error, and never exceeds it (a* <= 1 kept)."""
+    if which == "cook_torrance_ctrl":
+        seq = pump_sequence(brdfkit.model("cook-torrance"), "controlled", times=2)
+    else:
+        seq = request.getfixturevalue(which)
+    assert [m.chained for m in seq[1:]] == chained
+    wi, wo = _random_pairs(3000, 12)
+    r = wi * [-1, -1, 1]
+    wi, wo = np.r_[wi, wi], np.r_[wo, r]  # random pairs and mirror pairs (in the lobe)
+    for m in seq[1:]:
+        ref = _f_over_g_definition(m, wi, wo)
+        got = m.eval(wi, wo)
+        k = m.depth
+        np.testing.assert_allclose(got, ref, rtol=3 * LUT_TOL * k, atol=0)
+        assert np.all(got <= ref * (1 + 1e-12))
+
+
 # --------------------------------------------------------------------------- the theorem
 @pytest.mark.parametrize("which", ["phong_max", "blinn_max", "blinn_ctrl"])
 def test_theorem_repeated(which, request):
@@ -403,7 +497,11 @@ def test_custom_g_matches_builtin(blinn):
     pc = pump(blinn, lambda wi, wo, ai, ao: np.maximum(ai, ao))
     assert pc.kernel is None and pc.g == "custom"
     wi, wo = _random_pairs(500, 11)
-    np.testing.assert_allclose(pc.eval(wi, wo), pump(blinn, "max").eval(wi, wo), rtol=1e-12)
+    f_numpy, f_kernel = pc.eval(wi, wo), pump(blinn, "max").eval(wi, wo)
+    # the kernel reads a linear Lookup of 1/g derived from the same table: within
+    # LUT_TOL plus its margin (<= 3 LUT_TOL), and from below (g only grows: a* <= 1 stays)
+    np.testing.assert_allclose(f_kernel, f_numpy, rtol=3 * LUT_TOL)
+    assert np.all(f_kernel <= f_numpy * (1 + 1e-14))
     assert _alb(pc, [np.radians(60.0)])[0] <= 1.0 + 1e-6
 
 

@@ -175,6 +175,25 @@ ENGINE_TOL = 1e-8
 ENGINE_ERR = 5e-7
 #: Angles per engine call (bounds the engine's memory at deep levels).
 ENGINE_CHUNK = 8
+#: Evaluation lookup (:class:`Lookup`): first-level cells, uniform in μ = cos θ
+#: (doubled, up to LUT_MAX_CELLS, until no cell holds two kinks).
+LUT_CELLS = 64
+LUT_MAX_CELLS = 4096
+#: Relative tolerance of the lookup against the stage tables it is built from
+#: (its margin at most doubles it: the total stays well inside the 1e-5 budget).
+LUT_TOL = 5e-7
+#: Most intervals per cell; reached only for two kinks closer than 1/LUT_MAX_CELLS.
+LUT_MAX_SUB = 4096
+#: Check points per interval (the interpolant is compared with the function there).
+LUT_CHECK = 8
+#: A stage joins a chain (one lookup for all stages) when its tabulated albedo is
+#: non-decreasing in cos θ up to dips this small (they are filled by the running
+#: maximum, so g only grows: a rounding ripple of the table at normal incidence,
+#: ~1e-9, not a real minimum such as a Fresnel rise at grazing, ~1e-2).
+CHAIN_DIP_TOL = 2e-6
+#: Kinks closer than this are one kink for the lookup (the nearest-node error is
+#: then at most the slope jump times this, refined away like any smooth part).
+LUT_KINK_MERGE = 1e-4
 #: g is never smaller than this: a zero albedo with f > 0 can only come from
 #: rounding at the horizon, and dividing by it would give inf.
 G_FLOOR = 1e-12
@@ -185,34 +204,6 @@ class PumpingWarning(UserWarning):
 
 
 # --------------------------------------------------------------------------- albedo table
-@numba.njit(cache=True, inline="always")
-def _table_lookup(p, off, mu):  # pragma: no cover - compiled
-    """Albedo at cos θ = mu from the piecewise spline table stored at p[off:].
-
-    Layout: m (number of pieces), then per piece (start w, intervals per unit w,
-    first interval index, intervals), then 4 coefficients per interval. The pieces
-    split [w(THETA_TOP), 1] at the albedo's kinks; each is uniform in w.
-    """
-    # w = sqrt(1 - sqrt(1 - mu)), see AlbedoTable; clamp: |wi| = 1 up to rounding
-    r = 1.0 - mu
-    w = math.sqrt(1.0 - math.sqrt(r)) if r > 0.0 else 1.0
-    m = int(p[off])
-    i = 0
-    while i < m - 1 and w >= p[off + 1 + 4 * (i + 1)]:
-        i += 1  # at most a few pieces: a short scan
-    d = off + 1 + 4 * i
-    nn = int(p[d + 3])
-    x = (w - p[d]) * p[d + 1]
-    if x < 0.0:
-        x = 0.0  # beyond THETA_TOP: hold the last tabulated value (see module docstring)
-    j = int(x)
-    if j >= nn:
-        j = nn - 1  # mu = 1 (normal incidence) or 1 + rounding: last interval
-    t = x - j
-    b = off + 1 + 4 * m + 4 * (int(p[d + 2]) + j)
-    return ((p[b] * t + p[b + 1]) * t + p[b + 2]) * t + p[b + 3]
-
-
 @dataclass(frozen=True)
 class AlbedoTable:
     """The tabulated albedo of one model (one spline per channel).
@@ -270,16 +261,6 @@ class AlbedoTable:
         """Number of spline intervals."""
         return self.coeffs.shape[1]
 
-    def packed(self, c: int) -> np.ndarray:
-        """Channel *c*'s coefficients flattened for the kernel."""
-        m = len(self.piece_nn)
-        d = []
-        cum = 0
-        for i, nn in enumerate(self.piece_nn):
-            d += [self.breaks[i], nn / (self.breaks[i + 1] - self.breaks[i]), cum, nn]
-            cum += nn
-        return np.ascontiguousarray(np.concatenate([[float(m)], d, self.coeffs[c].reshape(-1)]))
-
     def __call__(self, theta) -> np.ndarray:
         """Tabulated albedo (an upper bound) at incidence angles *theta* (radians).
 
@@ -288,7 +269,7 @@ class AlbedoTable:
         return self.at_cos(np.cos(np.asarray(theta, dtype=np.float64)))
 
     def at_cos(self, mu) -> np.ndarray:
-        """Tabulated albedo at cos θ = *mu* (vectorised :func:`_table_lookup`)."""
+        """Tabulated albedo at cos θ = *mu* (NumPy; kernels read a :class:`Lookup` of it)."""
         mu = np.asarray(mu, dtype=np.float64)
         w = _w_of_mu(mu)
         nns = np.array(self.piece_nn)
@@ -434,6 +415,29 @@ def _nondecreasing(coeffs: np.ndarray) -> np.ndarray:
     return np.all(ok, axis=1)
 
 
+def _crossings(fn: Callable, grid: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Roots of *fn* (μ → (T, C)) bracketed by sign changes of *values* = fn(grid)."""
+    from scipy.optimize import brentq
+
+    out = []
+    for ch in range(values.shape[1]):
+        sg = np.signbit(values[:, ch])
+        for j in np.nonzero(sg[1:] != sg[:-1])[0]:
+            out.append(brentq(lambda m, ch=ch: float(fn(np.array([m]))[0, ch]),
+                              grid[j], grid[j + 1], xtol=1e-15))
+    return np.array(out, dtype=np.float64)
+
+
+def _running_max(albedo_at_cos: Callable, n: int = 1 << 15) -> tuple:
+    """Grid μ (ascending), the running maximum of the albedo on it (T, C), and the
+    largest amount by which that exceeds the albedo (0 for a non-decreasing one)."""
+    w = np.linspace(0.0, 1.0, n)
+    mu = 1.0 - (1.0 - w * w) ** 2  # dense at grazing, like the table's variable
+    a = _as_2d(albedo_at_cos(mu))
+    run = np.maximum.accumulate(a, axis=0)
+    return mu, run, float(np.max(run - a))
+
+
 def _as_2d(a: np.ndarray) -> np.ndarray:
     return a[:, None] if a.ndim == 1 else a
 
@@ -467,53 +471,278 @@ def _label(model) -> str:
     return getattr(model, "name", None) or repr(model)
 
 
+# --------------------------------------------------------------------------- evaluation lookup
+@numba.njit(cache=True, inline="always")
+def _lookup(p, off, mu):  # pragma: no cover - compiled
+    """Value at μ = *mu* of the piecewise-linear :class:`Lookup` stored at ``p[off:]``.
+
+    Two levels, no square root, no search: the cell is ``int(μ·M)``; inside it a
+    uniform grid anchored at the cell's kink (see :class:`Lookup`).
+    """
+    if not mu >= 0.0:
+        mu = 0.0  # only reached with mu > 0 from the kernels; keeps the index >= 0 regardless
+    if mu > 1.0:
+        mu = 1.0  # |ω| = 1 up to rounding (or an unnormalised input): keep the index in range
+    m = int(p[off])
+    j = int(mu * m)
+    if j > m - 1:
+        j = m - 1  # mu = 1: the last cell
+    h = off + 1 + 4 * j
+    y = (mu - p[h]) * p[h + 1]  # grid coordinate from the cell's anchor (>= 0 by construction)
+    k = int(y)
+    last = int(p[h + 3])
+    if k > last:
+        k = last  # the cell's last node (mu at the cell's upper edge)
+    b = off + int(p[h + 2]) + 2 * k
+    return p[b] + (y - k) * p[b + 1]
+
+
+@dataclass(frozen=True)
+class Lookup:
+    """A positive function of μ = cos θ ∈ [0, 1] stored for a fast kernel lookup.
+
+    The kernels of pumped models evaluate the albedo tables (or the product of a
+    whole chain of stages, see :class:`PumpedBRDF`) on every pair, so the lookup
+    must cost less than the base model: a square root (as in the table variable
+    of :class:`AlbedoTable`) or a search already costs a noticeable fraction of a
+    Phong evaluation. Here μ ∈ [0, 1] is split into ``M`` equal cells (the cell is
+    ``int(μ·M)``); each cell holds a uniform grid of its own spacing h (refined
+    until linear interpolation is within ``tol`` of the function, relative, at
+    ``LUT_CHECK`` points per interval) and is anchored at the function's kink in
+    that cell if it has one — nodes at anchor + i·h — so that a kink (where g₂
+    switches to N·L, where g reaches the cap 1, where the source table has a
+    piece boundary or ends at 89.9°) is always a node and never costs
+    refinement. ``M`` starts at ``LUT_CELLS`` and doubles until no cell holds
+    two kinks. Linear interpolation never overshoots the data, and the stored
+    values are scaled by (1 ± ε), ε twice the largest relative deficit found,
+    so the lookup bounds the function from the requested side.
+
+    Attributes
+    ----------
+    n_cells : int
+        M.
+    header : ndarray, shape (M, 4)
+        Per cell: anchor μ_a (≤ the cell's lower edge), 1/h, offset of the
+        cell's first (value, slope) pair (relative to the start of the packed
+        lookup), index of its last interval.
+    data : ndarray, shape (C, n, 2)
+        Per channel and interval: value at the left node and the increment to
+        the right node.
+    max_error : float
+        Largest relative |interpolant − function| over the check points
+        (before the margin).
+    epsilon : float
+        The margin's relative size.
+    bound : str
+        ``"upper"`` or ``"lower"``.
+    """
+
+    n_cells: int
+    header: np.ndarray
+    data: np.ndarray
+    max_error: float
+    epsilon: float
+    bound: str
+
+    @property
+    def n_intervals(self) -> int:
+        """Total number of linear intervals."""
+        return self.data.shape[1]
+
+    def packed(self, c: int) -> np.ndarray:
+        """Channel *c* flattened for :func:`_lookup`."""
+        return np.concatenate([[float(self.n_cells)], self.header.reshape(-1),
+                               self.data[c].reshape(-1)])
+
+    def __call__(self, mu) -> np.ndarray:
+        """Vectorised :func:`_lookup`: shape ``mu.shape + (C,)``."""
+        mu = np.clip(np.nan_to_num(np.asarray(mu, dtype=np.float64), nan=0.0), 0.0, 1.0)
+        j = np.minimum((mu * self.n_cells).astype(np.int64), self.n_cells - 1)
+        hd = self.header[j]
+        y = (mu - hd[..., 0]) * hd[..., 1]
+        k = np.minimum(y.astype(np.int64), hd[..., 3].astype(np.int64))
+        b = (hd[..., 2].astype(np.int64) - (1 + 4 * self.n_cells)) // 2 + k
+        d = self.data[:, b, :]  # (C, ..., 2)
+        out = d[..., 0] + (y - k) * d[..., 1]
+        return np.moveaxis(out, 0, -1)
+
+
+def build_lookup(fn: Callable, *, kinks=(), tol: float = LUT_TOL, bound: str = "upper",
+                 n_cells: int = LUT_CELLS) -> Lookup:
+    """Tabulate *fn* (μ of shape (T,) → positive values of shape (T, C)) as a :class:`Lookup`.
+
+    Parameters
+    ----------
+    fn : callable
+        Vectorised function of μ = cos θ ∈ [0, 1], positive and finite.
+    kinks : array_like, keyword-only
+        μ where *fn* is not smooth; they become grid nodes (up to two per
+        cell: the grid is anchored at the first and its spacing divides the
+        gap to the second; ``M`` doubles while a cell would hold three).
+        Kinks closer than ``LUT_KINK_MERGE`` count as one.
+    tol : float, keyword-only
+        Relative tolerance of the interpolant at the check points.
+    bound : {"upper", "lower"}, keyword-only
+        The side from which the stored lookup bounds *fn*.
+
+    Returns
+    -------
+    Lookup
+        Meets *tol* unless a cell would need more than ``LUT_MAX_SUB``
+        intervals; the margin then absorbs the larger error (``max_error``).
+        The bound is verified at every check point after the margin.
+    """
+    if bound not in ("upper", "lower"):
+        raise ParameterError(f"build_lookup: bound must be 'upper' or 'lower'; got {bound!r}")
+    kinks = np.unique(np.asarray([k for k in np.ravel(kinks) if 0.0 < k < 1.0], dtype=np.float64))
+    if kinks.size > 1:  # a cluster (e.g. a ripple crossing the cap 1 several times) is one kink
+        kinks = kinks[np.concatenate([[True], np.diff(kinks) > LUT_KINK_MERGE])]
+    m = int(n_cells)
+    while m < LUT_MAX_CELLS and kinks.size > 2 and np.any(
+            np.floor(kinks[2:] * m) == np.floor(kinks[:-2] * m)):
+        m *= 2  # three kinks in one cell: finer cells
+    kinks_of: dict = {}
+    for kk in kinks:
+        kinks_of.setdefault(min(int(kk * m), m - 1), []).append(float(kk))
+    lo = np.arange(m) / m
+    hi = np.arange(1, m + 1) / m
+    t_chk = (np.arange(LUT_CHECK) + 0.5) / LUT_CHECK
+    nsub = np.full(m, 2, dtype=np.int64)
+    pending = np.arange(m)
+    cells: dict = {}
+    worst = 0.0
+    while pending.size:
+        nodes, chk, spans = [], [], []
+        for j in pending:
+            h = (hi[j] - lo[j]) / nsub[j]
+            ks = kinks_of.get(int(j), [])
+            if len(ks) >= 2:  # both kinks on nodes: h divides their gap
+                h = (ks[1] - ks[0]) / math.ceil((ks[1] - ks[0]) / h)
+            a0 = lo[j] if not ks else ks[0] - math.ceil((ks[0] - lo[j]) / h - 1e-9) * h
+            n_int = max(1, math.ceil((hi[j] - a0) / h - 1e-9))
+            x = a0 + h * np.arange(n_int + 1)
+            nodes.append(x)
+            # check points inside the cell only (an anchored grid starts below it)
+            xc = np.clip(x[:-1, None] + h * t_chk[None, :], lo[j], hi[j])
+            chk.append(xc.reshape(-1))
+            spans.append((a0, h, n_int, (xc - x[:-1, None]) / h))
+        v_all = _as_2d(np.asarray(fn(np.concatenate(nodes)), dtype=np.float64))
+        c_all = _as_2d(np.asarray(fn(np.concatenate(chk)), dtype=np.float64))
+        if not (np.all(np.isfinite(v_all)) and np.all(v_all > 0.0)
+                and np.all(np.isfinite(c_all)) and np.all(c_all > 0.0)):
+            raise BrdfkitError("build_lookup: the function must be finite and positive on [0, 1]")
+        iv = ic = 0
+        still = []
+        for j, (a0, h, n_int, tc) in zip(pending, spans, strict=True):
+            v = v_all[iv:iv + n_int + 1]
+            c = c_all[ic:ic + n_int * LUT_CHECK].reshape(n_int, LUT_CHECK, -1)
+            iv += n_int + 1
+            ic += n_int * LUT_CHECK
+            err = float(np.max(np.abs(_interp(v, tc) - c) / c))
+            if err <= tol or nsub[j] >= LUT_MAX_SUB:
+                cells[int(j)] = (a0, h, v, c, tc)
+                worst = max(worst, err)
+            else:
+                nsub[j] *= 2
+                still.append(j)
+        pending = np.array(still, dtype=np.int64)
+
+    def stored(v, eps):
+        return v * (1.0 + eps if bound == "upper" else 1.0 - eps)
+
+    # margin: twice the largest deficit, then verified at every check point
+    sign = 1.0 if bound == "upper" else -1.0
+    eps = 4.0 * np.finfo(float).eps
+    for _ in range(8):
+        deficit = max(float(np.max(sign * (c - _interp(stored(v, eps), tc)) / c))
+                      for _, _, v, c, tc in cells.values())
+        if deficit <= 0.0:
+            break
+        eps += 2.0 * deficit
+    else:  # pragma: no cover - the deficit shrinks geometrically
+        raise BrdfkitError("build_lookup: could not make the lookup a bound of the function")
+    header = np.empty((m, 4))
+    data = []
+    pos = 1 + 4 * m
+    for j in range(m):
+        a0, h, v, _, _ = cells[j]
+        vv = stored(v, eps)
+        data.append(np.stack([vv[:-1], vv[1:] - vv[:-1]], axis=-1))  # (n_int, C, 2)
+        header[j] = (a0, 1.0 / h, pos, len(v) - 2)
+        pos += 2 * (len(v) - 1)
+    data = np.ascontiguousarray(np.transpose(np.concatenate(data, axis=0), (1, 0, 2)))
+    return Lookup(n_cells=m, header=header, data=data, max_error=worst, epsilon=eps,
+                  bound=bound)
+
+
+def _interp(v: np.ndarray, tc: np.ndarray) -> np.ndarray:
+    """Linear interpolation of node values v (n+1, C) at local coordinates tc (n, L)."""
+    return v[:-1, None, :] + tc[:, :, None] * (v[1:] - v[:-1])[:, None, :]
+
+
 # --------------------------------------------------------------------------- kernels
 _KERNELS: dict = {}
 
 
-def _pumped_kernel(base_kernel, g_code: int):
-    """The compiled kernel f/g for *base_kernel* and built-in g (cached).
+def _chain_kernel(root_kernel, k: int, capped: bool):
+    """The compiled kernel f·q(max(N·L, N·V)) of a chain of monotone stages (cached).
 
-    Packed parameters of one channel (``p``), from the left: the base's
-    parameters (K values), the table (see :func:`_table_lookup`), then the header
-    ``[monotone, cap, s_top, nn, K]`` read from the right — so the layout nests and a
-    pumped kernel can be pumped again.
+    Packed parameters of one channel (``p``): the root model's K parameters,
+    then the :class:`Lookup` of q = 1/∏ g_j at the constant offset K (then
+    possibly later stages' lookups and the offsets trailer, see
+    :meth:`PumpedBRDF._pack`). The root kernel reads its parameters from the
+    front of ``p`` — no slicing, and a compile-time offset: both measurably
+    cheaper than reading the offset from ``p`` and slicing. *capped*: every
+    stage caps g at 1, so q ≥ 1 exactly (the lookup's margin may dip below 1
+    where q = 1; raising it back keeps q̃ ≤ q because q ≥ 1 there).
     """
-    key = (base_kernel, g_code)
-    if key in _KERNELS:
-        return _KERNELS[key]
-    controlled = g_code == 1
+    key = (root_kernel, "chain", k, capped)
+    if key not in _KERNELS:
+        @numba.njit
+        def kernel(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
+            f = root_kernel(ix, iy, iz, ox, oy, oz, p)  # 0 below the horizon
+            if f == 0.0:
+                return 0.0  # nothing to pump (outside the lobe, below the horizon)
+            q = _lookup(p, k, iz if iz > oz else oz)
+            if capped and q < 1.0:
+                q = 1.0  # eq. (17) g <= 1 for every stage
+            return f * q
 
-    @numba.njit
-    def kernel(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
-        if iz <= 0.0 or oz <= 0.0:
-            return 0.0
-        m = p.shape[0]
-        k = int(p[m - 1])
-        f = base_kernel(ix, iy, iz, ox, oy, oz, p[:k])
-        if f == 0.0:
-            return 0.0  # nothing to pump (outside the lobe): skip the lookups
-        if p[m - 5] != 0.0:
-            # the tabulated albedo is non-decreasing in cos θ (checked at build time), so
-            # max(a(L), a(V)) = a(max(N·L, N·V)): one lookup instead of two
-            g = _table_lookup(p, k, iz if iz > oz else oz)
-        else:
-            a_i = _table_lookup(p, k, iz)
-            a_o = _table_lookup(p, k, oz)
+        _KERNELS[key] = kernel
+    return _KERNELS[key]
+
+
+def _stage_kernel(base_kernel, controlled: bool, capped: bool, depth: int):
+    """The compiled kernel f/g of stage number *depth* with two albedo lookups (cached).
+
+    The base kernel (pumped or not) reads the same packed row ``p``; this
+    stage's :class:`Lookup` starts at ``p[len(p) - depth]`` (the offsets trailer
+    of :meth:`PumpedBRDF._pack`), so stages nest without slicing. *capped*:
+    g ≤ 1 (eq. 17) is applied after the lookup (whose margin may exceed 1
+    where a = 1).
+    """
+    key = (base_kernel, "stage", controlled, capped, depth)
+    if key not in _KERNELS:
+        @numba.njit
+        def kernel(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
+            f = base_kernel(ix, iy, iz, ox, oy, oz, p)  # 0 below the horizon
+            if f == 0.0:
+                return 0.0
+            off = int(p[p.shape[0] - depth])
+            a_i = _lookup(p, off, iz)
+            a_o = _lookup(p, off, oz)
             g = a_i if a_i > a_o else a_o
-        if controlled:
-            if iz > g:
-                g = iz
-            if oz > g:
-                g = oz
-        if p[m - 4] != 0.0 and g > 1.0:
-            g = 1.0  # eq. (17) g <= 1 (the table's margin may exceed 1 where a = 1)
-        if g < G_FLOOR:
-            g = G_FLOOR  # a = 0 with f > 0 only by rounding at the horizon; avoid inf
-        return f / g
+            if capped and g > 1.0:
+                g = 1.0  # eq. (17) g <= 1
+            if controlled:
+                if iz > g:
+                    g = iz
+                if oz > g:
+                    g = oz
+            return f / g
 
-    _KERNELS[key] = kernel
-    return kernel
+        _KERNELS[key] = kernel
+    return _KERNELS[key]
 
 
 def _g_max(wi, wo, a_i, a_o):
@@ -563,6 +792,7 @@ class PumpedBRDF(BRDF):
         self.g = g if isinstance(g, str) else "custom"
         self._g_callable = None if isinstance(g, str) else g
         self.stages = (base.stages if isinstance(base, PumpedBRDF) else []) + [self.g]
+        self.depth = len(self.stages)
         self.params = self.root.params
         self.has_sampler = base.has_sampler
         self.width_param = self.root.width_param
@@ -572,6 +802,7 @@ class PumpedBRDF(BRDF):
         self.summary = f"{self.root.name} with its albedo pumped up ({', '.join(self.stages)})"
         self._values = self.root._values
         self.n_channels = base.n_channels
+        self._n_rows = np.asarray(base.packed).shape[0]  # 1, or the number of channels
         self.table = build_albedo_table(base)
         self.capped = bool(np.all(self.table.max_albedo - self.table.max_midpoint_error
                                   <= 1.0 + ENGINE_ERR))
@@ -588,8 +819,34 @@ class PumpedBRDF(BRDF):
         if self._g_callable is not None:
             _validate_g(self._g_callable, self._albedo_at_cos)
         base_kernel = getattr(base, "kernel", None)
+        self.lookups: tuple = ()
+        self.chained = False
+        self._chain: tuple = ()
         if base_kernel is not None and self._g_callable is None:
-            self.kernel = _pumped_kernel(base_kernel, G_CHOICES[self.g])
+            parent_chained = not isinstance(base, PumpedBRDF) or base.chained
+            self._mono_mu, self._mono_a, dip = _running_max(self._albedo_at_cos)
+            if parent_chained and dip <= CHAIN_DIP_TOL:
+                # every stage so far has a non-decreasing albedo: the whole chain is
+                # f_root · q(max(N·L, N·V)) with one lookup (see the class docstring)
+                self.chained = True
+                self._chain = (base._chain if isinstance(base, PumpedBRDF) else ()) + (self,)
+                # one lookup per channel (each with its own grid and margin, so a coloured
+                # model pumps exactly like its channels pumped one by one)
+                self.lookups = tuple(
+                    build_lookup(lambda mu, c=c: self._chain_q(mu)[:, c:c + 1], bound="lower",
+                                 kinks=np.concatenate([s._divisor_kinks(c) for s in self._chain]))
+                    for c in range(self._n_rows))
+                self.kernel = _chain_kernel(self.root.kernel,
+                                            np.asarray(self.root.packed).shape[1],
+                                            all(s.capped for s in self._chain))
+            else:
+                self.lookups = tuple(
+                    build_lookup(lambda mu, c=c: np.maximum(
+                        _as_2d(self._albedo_at_cos(mu))[:, c:c + 1], G_FLOOR),
+                        bound="upper", kinks=self._divisor_kinks(c, table_only=True))
+                    for c in range(self._n_rows))
+                self.kernel = _stage_kernel(base_kernel, self.g == "controlled", self.capped,
+                                            self.depth)
         else:
             self.kernel = None
         self._packed = self._pack()
@@ -617,16 +874,88 @@ class PumpedBRDF(BRDF):
                         grid[j], grid[j + 1], xtol=1e-14))
         return tuple(sorted(set(round(float(m), 14) for m in out)))
 
+    # ------------------------------------------------------- evaluation lookup
+    def _divisor(self, mu) -> np.ndarray:
+        """This stage's g as a function of μ = max(N·L, N·V), shape (T, C).
+
+        The running maximum â(μ) = max over μ' ≤ μ of the capped table
+        (equal to it where the table is non-decreasing; the chain is used only
+        when the two differ by at most CHAIN_DIP_TOL), so that max(a(L), a(V))
+        ≤ â(max(N·L, N·V)); raised to μ for g₂ (eq. 21), floored at G_FLOOR.
+        """
+        mu = np.asarray(mu, dtype=np.float64)
+        # the running maximum from grazing: max(a(L), a(V)) <= g(max(N·L, N·V)) exactly
+        idx = np.searchsorted(self._mono_mu, mu, side="right") - 1
+        g = np.maximum(_as_2d(self._albedo_at_cos(mu)), self._mono_a[np.maximum(idx, 0)])
+        if self.g == "controlled":
+            g = np.maximum(g, np.clip(mu, 0.0, 1.0)[:, None])
+        return np.maximum(g, G_FLOOR)
+
+    def _chain_q(self, mu) -> np.ndarray:
+        """q(μ) = 1/∏ g_j(μ) over the chained stages, shape (T, C)."""
+        q = 1.0 / self._chain[0]._divisor(mu)
+        for stage in self._chain[1:]:
+            q = q / stage._divisor(mu)
+        return q
+
+    def _divisor_kinks(self, c: int, table_only: bool = False) -> np.ndarray:
+        """μ where channel *c* of this stage's g(μ) is not smooth: the table's piece
+        boundaries and its end at THETA_TOP, where it reaches the cap 1, and (g₂)
+        where it crosses μ."""
+        w = self.table.breaks[:-1]
+        out = [1.0 - (1.0 - w * w) ** 2]
+        grid = np.linspace(0.0, 1.0, 4097)
+
+        def a(m):
+            return _as_2d(self.table.at_cos(m))[:, c:c + 1]
+
+        raw = a(grid)
+        if self.capped:
+            out.append(_crossings(lambda m: a(m) - 1.0, grid, raw - 1.0))
+        if self.g == "controlled" and not table_only:
+            out.append(_crossings(lambda m: np.minimum(a(m), 1.0 if self.capped else np.inf)
+                                  - m[:, None], grid,
+                                  np.minimum(raw, 1.0 if self.capped else np.inf) - grid[:, None]))
+        return np.concatenate(out)
+
     # ---------------------------------------------------------------- packing
     def _pack(self) -> np.ndarray:
-        bp = np.asarray(self.base.packed)
-        k = bp.shape[1]
+        """Packed rows for the kernel: root parameters, lookups, offsets trailer.
+
+        Layout of channel c: the root's K parameters; the lookup of the last
+        chained stage (at offset K, read by :func:`_chain_kernel`); the lookup
+        of every later (unchained) stage; then a trailer of ``depth`` offsets,
+        ``p[len(p) - d]`` = start of stage d's lookup (0 for chained stages),
+        read by :func:`_stage_kernel`. Every nested kernel reads this one row.
+        """
+        if self.kernel is None:
+            return np.asarray(self.base.packed)  # not used by a kernel
+        chain = []
+        node = self
+        while isinstance(node, PumpedBRDF):
+            chain.append(node)
+            node = node.base
+        chain.reverse()  # stage 1 … depth
+        root = np.asarray(self.root.packed)
+        last_chained = max((s for s in chain if s.chained), key=lambda s: s.depth, default=None)
         rows = []
-        for c in range(bp.shape[0]):
-            header = [1.0 if self.table.nondecreasing[c] else 0.0, 1.0 if self.capped else 0.0,
-                      self.table.s_top, float(self.table.n_intervals), float(k)]
-            rows.append(np.concatenate([bp[c], self.table.packed(c), header]))
-        return np.ascontiguousarray(np.array(rows, dtype=np.float64))
+        for c in range(root.shape[0]):
+            parts = [root[c]]
+            pos = root.shape[1]
+            offsets = np.zeros(self.depth)
+            for stage in chain:
+                if stage.chained and stage is not last_chained:
+                    continue  # superseded by the last chained stage's product lookup
+                offsets[stage.depth - 1] = 0.0 if stage.chained else pos
+                block = stage.lookups[c].packed(0)
+                parts.append(block)
+                pos += block.size
+            rows.append((parts, offsets[::-1]))  # p[len(p) - d] is stage d's offset
+        # channels' lookups differ in length: pad before the trailer
+        width = max(sum(x.size for x in parts) for parts, _ in rows)
+        return np.ascontiguousarray(np.array(
+            [np.concatenate(parts + [np.zeros(width - sum(x.size for x in parts)), trailer])
+             for parts, trailer in rows], dtype=np.float64))
 
     # -------------------------------------------------------------- evaluation
     def eval(self, wi, wo) -> np.ndarray:

@@ -67,7 +67,7 @@ def _two_panel(curves: dict, title: str, caption: str, *, ref_radiance: float | 
 
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(10.4, 4.0))
     th = curves["theta_deg"]
-    for k, (a, r) in enumerate(zip(curves["albedo"], curves["radiance"])):
+    for k, (a, r) in enumerate(zip(curves["albedo"], curves["radiance"], strict=True)):
         label = "original" if k == 0 else f"pumped {k}x"
         style = "k-" if k == 0 else "-"
         ax.plot(th, a, style, label=label)
