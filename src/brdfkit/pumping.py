@@ -88,26 +88,51 @@ eq. (22)'s stays at 0.51 at 89.9°.
 The albedo table
 ----------------
 Each stage tabulates the albedo of its base once, with the albedo engine
-(:func:`brdfkit.analysis.albedo`), on a grid uniform in w = √(1 − √(1 − cos θ))
-over θ ∈ [0, 89.9°] — linear in θ at normal incidence, dense near grazing
+(:func:`brdfkit.analysis.albedo`), on a grid uniform in w = √(1 − √(1 − cos
+θ)) over θ ∈ [0, 89.9°] — linear in θ at normal incidence, dense near grazing
 where sharp lobes are cut by the horizon (see :class:`AlbedoTable`) — and
 interpolates with a cubic spline. The grid is doubled until the spline,
 checked against the engine at every interval midpoint, is within
 ``INTERP_TOL`` there. A pumped stage's albedo has kinks (for g₂: where the
-previous table a(θ) crosses cos θ, since g switches from a(L) to N·L for all
-V at once; the base's kinks carry over): :class:`PumpedBRDF` lists them in
+previous table a(θ) crosses cos θ, since g switches from a(L) to N·L for all V
+at once; the base's kinks carry over): :class:`PumpedBRDF` lists them in
 ``albedo_kink_mus`` and the next table is split there into pieces, each with
 its own uniform grid and spline, so no interval straddles a kink (the
-controlled Blinn n = 20 stage-3 table needs 54 intervals instead of > 512,
-and builds in seconds); the lookup scans the few piece starts, still O(1). The stored table is
-the spline **plus** a margin δ = 2 × (largest midpoint error) + ``ENGINE_ERR``
-(5e-7), so it is an upper bound of the albedo and g ≥ a(L) holds — the
-theorem's only requirement — in spite of rounding: a* ≤ 1 with no tolerance.
-The total error of the table stays below 1e-5. Beyond 89.9° (the engine's
-stated range) the table is extended by its last value; for the Phong family,
-whose albedo falls toward grazing, that over-estimates a and stays safe.
+controlled Blinn n = 20 stage-3 table needs 54 intervals instead of > 512, and
+builds in seconds). The stored table is the spline **plus** a margin δ = 2 ×
+(largest midpoint error) + ``ENGINE_ERR`` (5e-7), so it is an upper bound of
+the albedo and g ≥ a(L) holds — the theorem's only requirement — in spite of
+rounding: a* ≤ 1 with no tolerance. The total error of the table stays below
+1e-5. Beyond 89.9° (the engine's stated range) the table is extended by its
+last value; for the Phong family, whose albedo falls toward grazing, that
+over-estimates a and stays safe.
 Coloured models get one table per channel. Anisotropic bases (attribute
 ``isotropic`` False) are refused: their albedo is not a function of θ alone.
+
+Evaluation: one lookup for a whole chain
+----------------------------------------
+The kernel of a pumped model runs on every pair, so its table reads must cost
+less than the base model (issue target: ≤ 1.3 × the base's time). The spline
+above, in w, needs two square roots per read; the kernels instead read a
+:class:`Lookup` derived from it: piecewise *linear* in μ = cos θ on two
+levels (cell ``int(μ·M)``, then a uniform grid inside the cell, anchored so
+that the function's kinks are nodes), within ``LUT_TOL`` (5e-7, relative) of
+the table, with a margin that keeps the bound on the safe side. And when the
+tabulated albedo is non-decreasing in cos θ — the Phong and Blinn families,
+but not a Fresnel rise at grazing — max(a(L), a(V)) = a(max(N·L, N·V)), and
+N·L, N·V enter g₂ the same way, so every stage's g is a function of
+μ = max(N·L, N·V) alone and k stages collapse into
+
+    f⁽ᵏ⁾(L, V) = f(L, V) · q(μ),   q(μ) = 1 / ∏ⱼ gⱼ(μ),
+
+one lookup however many pumpings (:class:`PumpedBRDF` attribute
+``chained``; a ripple of the table up to ``CHAIN_DIP_TOL`` is filled by the
+running maximum, which only raises g). A stage whose albedo is not monotone
+wraps the previous kernel with two lookups, as eq. (20) is written. The
+lookup of q bounds it from below, the lookup of a from above, and the cap
+g ≤ 1 is applied in the kernel after the read, so the kernel's f* never
+exceeds the stage-by-stage definition with the tables (a* ≤ 1 is kept) and
+pumping never lowers f.
 
 Public objects
 --------------
@@ -115,6 +140,7 @@ Public objects
 - :class:`PumpedBRDF` — the result (a :class:`brdfkit.models.BRDF`).
 - :class:`AlbedoTable` — a stage's tabulated albedo.
 - :func:`build_albedo_table` — tabulate any model's albedo.
+- :class:`Lookup`, :func:`build_lookup` — the kernels' fast table of a function of cos θ.
 - :func:`from_dict` — rebuild a (pumped) model from ``to_dict()``.
 - :func:`pump_sequence` — the model and its 1 … k times pumped versions.
 - :func:`mirror_radiance` — f(L, R(L)) cos θ_L, the paper's output radiance.
@@ -143,9 +169,11 @@ from brdfkit.models._base import BRDF
 __all__ = [
     "G_CHOICES",
     "AlbedoTable",
+    "Lookup",
     "PumpedBRDF",
     "PumpingWarning",
     "build_albedo_table",
+    "build_lookup",
     "from_dict",
     "mirror_radiance",
     "pump",
@@ -782,6 +810,16 @@ class PumpedBRDF(BRDF):
         Whether g is capped at 1 (False only for a base that gains energy).
     stages : list of str
         The g of every stage, innermost first.
+    depth : int
+        ``len(stages)``.
+    chained : bool
+        Whether this stage and all below it have non-decreasing albedos, so
+        the kernel is f_root · q(max(N·L, N·V)) with one lookup (module
+        docstring, "Evaluation"); otherwise the kernel wraps the base's
+        with two lookups of this stage's albedo.
+    lookups : tuple of Lookup
+        Per channel: q of the chain (``chained``) or this stage's capped
+        albedo; empty for a custom g (evaluated in NumPy from ``table``).
     """
 
     reciprocal = True
@@ -860,18 +898,14 @@ class PumpedBRDF(BRDF):
         Switches between a(L) and a(V) or N·V sweep over V smoothly and leave a*
         smooth. The base's kinks carry over (g uses a(L)).
         """
-        from scipy.optimize import brentq
-
         out = list(getattr(self.base, "albedo_kink_mus", ()))
         if self.g == "controlled":
             grid = np.linspace(1e-6, 1.0, 2049)
-            d = _as_2d(self._albedo_at_cos(grid)) - grid[:, None]
-            for ch in range(d.shape[1]):
-                sg = np.signbit(d[:, ch])
-                for j in np.nonzero(sg[1:] != sg[:-1])[0]:
-                    out.append(brentq(lambda m, ch=ch: float(_as_2d(
-                        self._albedo_at_cos(np.array([m])))[0, ch] - m),
-                        grid[j], grid[j + 1], xtol=1e-14))
+
+            def diff(m):
+                return _as_2d(self._albedo_at_cos(m)) - m[:, None]
+
+            out += list(_crossings(diff, grid, diff(grid)))
         return tuple(sorted(set(round(float(m), 14) for m in out)))
 
     # ------------------------------------------------------- evaluation lookup
