@@ -164,7 +164,7 @@ import numpy as np
 
 from brdfkit._array import as_directions
 from brdfkit.errors import BrdfkitError, ParameterError
-from brdfkit.models._base import BRDF
+from brdfkit.models._base import BRDF, checked_driver
 
 __all__ = [
     "G_CHOICES",
@@ -713,7 +713,7 @@ _KERNELS: dict = {}
 
 
 def _chain_kernel(root_kernel, k: int, capped: bool):
-    """The compiled kernel f·q(max(N·L, N·V)) of a chain of monotone stages (cached).
+    """(kernel, driver) for f·q(max(N·L, N·V)), a chain of monotone stages (cached).
 
     Packed parameters of one channel (``p``): the root model's K parameters,
     then the :class:`Lookup` of q = 1/∏ g_j at the constant offset K (then
@@ -726,7 +726,7 @@ def _chain_kernel(root_kernel, k: int, capped: bool):
     """
     key = (root_kernel, "chain", k, capped)
     if key not in _KERNELS:
-        @numba.njit
+        @numba.njit(inline="always")  # inlined into its own driver (checked_driver)
         def kernel(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
             f = root_kernel(ix, iy, iz, ox, oy, oz, p)  # 0 below the horizon
             if f == 0.0:
@@ -736,12 +736,12 @@ def _chain_kernel(root_kernel, k: int, capped: bool):
                 q = 1.0  # eq. (17) g <= 1 for every stage
             return f * q
 
-        _KERNELS[key] = kernel
+        _KERNELS[key] = kernel, checked_driver(kernel)
     return _KERNELS[key]
 
 
 def _stage_kernel(base_kernel, controlled: bool, capped: bool, depth: int):
-    """The compiled kernel f/g of stage number *depth* with two albedo lookups (cached).
+    """(kernel, driver) for f/g of stage number *depth*, two albedo lookups (cached).
 
     The base kernel (pumped or not) reads the same packed row ``p``; this
     stage's :class:`Lookup` starts at ``p[len(p) - depth]`` (the offsets trailer
@@ -751,7 +751,7 @@ def _stage_kernel(base_kernel, controlled: bool, capped: bool, depth: int):
     """
     key = (base_kernel, "stage", controlled, capped, depth)
     if key not in _KERNELS:
-        @numba.njit
+        @numba.njit(inline="always")  # inlined into its own driver (checked_driver)
         def kernel(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
             f = base_kernel(ix, iy, iz, ox, oy, oz, p)  # 0 below the horizon
             if f == 0.0:
@@ -769,7 +769,7 @@ def _stage_kernel(base_kernel, controlled: bool, capped: bool, depth: int):
                     g = oz
             return f / g
 
-        _KERNELS[key] = kernel
+        _KERNELS[key] = kernel, checked_driver(kernel)
     return _KERNELS[key]
 
 
@@ -874,19 +874,19 @@ class PumpedBRDF(BRDF):
                     build_lookup(lambda mu, c=c: self._chain_q(mu)[:, c:c + 1], bound="lower",
                                  kinks=np.concatenate([s._divisor_kinks(c) for s in self._chain]))
                     for c in range(self._n_rows))
-                self.kernel = _chain_kernel(self.root.kernel,
-                                            np.asarray(self.root.packed).shape[1],
-                                            all(s.capped for s in self._chain))
+                self.kernel, self._driver = _chain_kernel(
+                    self.root.kernel, np.asarray(self.root.packed).shape[1],
+                    all(s.capped for s in self._chain))
             else:
                 self.lookups = tuple(
                     build_lookup(lambda mu, c=c: np.maximum(
                         _as_2d(self._albedo_at_cos(mu))[:, c:c + 1], G_FLOOR),
                         bound="upper", kinks=self._divisor_kinks(c, table_only=True))
                     for c in range(self._n_rows))
-                self.kernel = _stage_kernel(base_kernel, self.g == "controlled", self.capped,
-                                            self.depth)
+                self.kernel, self._driver = _stage_kernel(
+                    base_kernel, self.g == "controlled", self.capped, self.depth)
         else:
-            self.kernel = None
+            self.kernel = self._driver = None
         self._packed = self._pack()
         self.albedo_kink_mus = self._kink_mus()
 

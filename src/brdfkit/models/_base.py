@@ -29,6 +29,8 @@ Public objects
 - :func:`eval_pairs` — the compiled driver (for code that has packed arrays).
 - :func:`eval_pairs_checked` — the same, also testing the directions for NaN/inf
   in the same pass (what :meth:`BRDF.eval` uses).
+- :func:`checked_driver` — :func:`eval_pairs_checked` compiled for one kernel,
+  inlined (for composite kernels such as pumped models').
 """
 
 from __future__ import annotations
@@ -45,7 +47,7 @@ from brdfkit._array import as_directions, as_uniform
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.geometry import pdf_cosine_hemisphere, sample_cosine_hemisphere
 
-__all__ = ["Param", "Lobe", "BRDF", "eval_pairs", "eval_pairs_checked"]
+__all__ = ["Param", "Lobe", "BRDF", "checked_driver", "eval_pairs", "eval_pairs_checked"]
 
 
 @dataclass(frozen=True)
@@ -204,6 +206,48 @@ def eval_pairs(kernel, wi, wo, P, out):  # pragma: no cover - compiled
             for c in range(n_channels):
                 out[j, c] = kernel(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2],
                                    P[c])
+
+
+def checked_driver(kernel):
+    """:func:`eval_pairs_checked` specialised to one *kernel* (a new compiled function).
+
+    :func:`eval_pairs_checked` calls its kernel through a first-class function
+    argument, which LLVM inlines only when the kernel is small; a composite
+    kernel (a pumped model: the base kernel plus table lookups) then stays an
+    out-of-line call per pair, with its packed-array argument spilled to the
+    stack. Here the kernel is a closure variable, so Numba inlines it into the
+    loop when it is declared ``inline="always"``. Measured on 10 M pairs: a
+    pumped Phong at the base model's speed instead of 1.2-1.6x slower. A model
+    opts in by setting its ``_driver`` attribute (see :meth:`BRDF.eval`).
+    """
+
+    @numba.njit(parallel=True)
+    def driver(wi, wo, P, out):  # pragma: no cover - compiled
+        n = wi.shape[0]
+        n_channels = P.shape[0]
+        n_bad = 0
+        if n_channels == 1:
+            p = P[0]  # hoisted, as in eval_pairs_checked
+            for j in numba.prange(n):
+                ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
+                ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
+                if _finite6(ix, iy, iz, ox, oy, oz):
+                    out[j, 0] = kernel(ix, iy, iz, ox, oy, oz, p)
+                else:
+                    out[j, 0] = math.nan
+                    n_bad += 1
+        else:
+            for j in numba.prange(n):
+                ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
+                ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
+                ok = _finite6(ix, iy, iz, ox, oy, oz)
+                for c in range(n_channels):
+                    out[j, c] = kernel(ix, iy, iz, ox, oy, oz, P[c]) if ok else math.nan
+                if not ok:
+                    n_bad += 1
+        return n_bad
+
+    return driver
 
 
 @numba.njit(inline="always")
@@ -448,7 +492,10 @@ class BRDF:
         wi2 = np.ascontiguousarray(wi.reshape(-1, 3))
         wo2 = np.ascontiguousarray(wo.reshape(-1, 3))
         out = np.empty((wi2.shape[0], self._packed.shape[0]))
-        if eval_pairs_checked(self.kernel, wi2, wo2, self._packed, out):
+        driver = getattr(self, "_driver", None)
+        n_bad = (driver(wi2, wo2, self._packed, out) if driver is not None
+                 else eval_pairs_checked(self.kernel, wi2, wo2, self._packed, out))
+        if n_bad:
             as_directions(wi_in, "wi")  # raises the usual BrdfkitError for NaN/inf
             as_directions(wo_in, "wo")
             raise BrdfkitError("wi or wo contains NaN or infinite components")  # unreachable
