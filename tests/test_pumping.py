@@ -464,6 +464,21 @@ def test_controlled_radiance_bound_pointwise(name, params):
     assert np.all(fs >= f * (1 - 1e-12))  # g <= 1: pumping never lowers f
 
 
+def test_paper_observations_n20(phong_max, blinn_ctrl):
+    """§3.2 for n = 20, quantified with rho_hh (engine quadrature, independent of the
+    tables): Phong (g2 = g1, test above) is worth 2-3 pumpings -- gains 0.23, 0.07, then
+    < 0.02; Blinn's first CONTROLLED pumping gains less than its second (0.115 vs 0.18),
+    contrary to the paper's "does not significantly increase with the second" (docstring)."""
+    from brdfkit.analysis import hemispherical_albedo
+
+    r_p = [float(hemispherical_albedo(m, n=24)[0]) for m in phong_max]
+    gain_p = np.diff(r_p)
+    assert gain_p[0] > 0.2 and gain_p[1] > 0.05 and gain_p[2] < 0.02 and gain_p[3] < 0.01
+    r_b = [float(hemispherical_albedo(m, n=24)[0]) for m in blinn_ctrl]
+    gain_b = np.diff(r_b)
+    assert 0.09 < gain_b[0] < 0.14 and gain_b[1] > 0.15 and gain_b[2] > 0.05
+
+
 def test_super_metal_g1_vs_g2(blinn, blinn_max, blinn_ctrl, phong, phong_max):
     """§3.1/§3.2: g1 makes the Blinn mirror overshoot its normal-incidence radiance c
     (c = f(L, R(L)), constant for Blinn/Phong); one g2 stage cannot (proved), and for the

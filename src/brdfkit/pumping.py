@@ -75,7 +75,23 @@ cos θ_o < 0 from ∫ c cosⁿα cos θ_o dω = cos θ), pumping only raises a, 
 g₂ = g₁ at every stage; with n = 20 the mirror radiance after 2, 3, 5
 pumpings peaks at 1.36, 1.61, 1.91 × c (at θ ≈ 80°, 83°, 85°). For Blinn
 (n = 20), whose albedo dips below cos θ, g₂ does differ from g₁ (g₁ gives
-peaks of 1.69, 5.05, 10.99 × c after 1, 2, 3 pumpings: the super-metal).
+peaks of 1.69, 5.05, 10.99 × c after 1, 2, 3 pumpings: the super-metal; g₂
+gives exactly c at every angle after one pumping — f* = c cos θ/cos θ — and
+then 6.66 and 17.4 × c at 85.9° after 2 and 3).
+
+The paper's n = 20 observations (§3.2), quantified as the
+hemispherical–hemispherical albedo ρ_hh after k = 0 … 5 controlled pumpings
+(``tests/test_pumping.py::test_paper_observations_n20``): Phong 0.669, 0.903,
+0.975, 0.993, 0.997, 0.999 — gains 0.234, 0.072, 0.017, 0.005, so "worth
+pumping 2 or 3 times" holds (a(80°): 0.200, 0.638, 0.870, 0.949, 0.978,
+0.990). Blinn 0.550, 0.665, 0.848, 0.942, 0.979, 0.991 — gains 0.115, 0.183,
+0.094, 0.036, 0.013: the *first* controlled pumping is the one held back (g₂ =
+N·L wherever a < cos θ), the second gains more, and the albedo tends to 1.
+So "the albedo of the Blinn model does not significantly increase with the
+second and consecutive pumping-up operations" and "the process will converge
+to an albedo that is below the constant 1" do not hold for eq. (21) as
+printed: after one controlled pumping a* ≥ cos θ almost everywhere, g₂ = g₁
+from then on, and the radiance bound is lost with it (above).
 
 Eq. (22) is close to *one* controlled pumping of Phong, not to its limit:
 for n = 20 the best-fit c_n is 0.936 × (n+2)/2π after one pumping (median
