@@ -307,6 +307,24 @@ def test_lookup_kernel_matches_numpy_and_is_memory_safe():
     assert edge[1] == edge[2] == edge[0] and edge[3] == edge[4] == run(p, np.array([0.0]))[0]
 
 
+def test_own_driver_matches_generic_loop_and_rejects_nan(phong_max):
+    """A pumped model evaluates through its own compiled loop (checked_driver, the kernel
+    inlined); it must give what the generic first-class-function loop gives, and report
+    non-finite directions like every model."""
+    from brdfkit.errors import BrdfkitError
+    from brdfkit.models._base import eval_pairs_checked
+
+    m = phong_max[2]
+    assert m._driver is not None
+    wi, wo = _random_pairs(2000, 13)
+    ref = np.empty((2000, 1))
+    assert eval_pairs_checked(m.kernel, wi, wo, m.packed, ref) == 0
+    np.testing.assert_allclose(m.eval(wi, wo), ref[:, 0], rtol=1e-15, atol=0)
+    wi[7, 1] = np.nan
+    with pytest.raises(BrdfkitError, match="wi contains NaN"):
+        m.eval(wi, wo)
+
+
 def _f_over_g_definition(model, wi, wo):
     """f_root / ∏ g_k from each stage's own albedo table (eqs. 16, 20, 21 stage by stage):
     the reference for the one-lookup chain kernel."""
