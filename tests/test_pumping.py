@@ -260,17 +260,21 @@ def test_table_split_at_kinks(blinn_ctrl):
 
 
 # --------------------------------------------------------------------------- evaluation lookup
+KINKS = [0.3, 0.3051]  # two kinks in one first-level cell ([19/64, 20/64))
+
+
 def _kinked(mu):
-    # closed form with a kink at mu = 0.3 (slope jump 2) and a sharp rise near grazing
+    # closed form with kinks at KINKS (slope jumps 2 and 1) and a sharp rise near grazing
     mu = np.asarray(mu, dtype=float)
-    return (1.0 + np.abs(mu - 0.3) + 0.5 * np.exp(-mu / 0.01))[:, None]
+    return (1.0 + np.abs(mu - KINKS[0]) + 0.5 * np.abs(mu - KINKS[1])
+            + 0.5 * np.exp(-mu / 0.01))[:, None]
 
 
 @pytest.mark.parametrize("bound", ["upper", "lower"])
 def test_lookup_accuracy_bound_and_kink_anchoring(bound):
     """Lookup vs a closed form at 2e5 random points: within 3 LUT_TOL, on the requested side;
-    a declared kink is a grid node (no refinement), an undeclared one costs intervals."""
-    lk = build_lookup(_kinked, kinks=[0.3], bound=bound)
+    declared kinks are grid nodes (no refinement), undeclared ones cost intervals."""
+    lk = build_lookup(_kinked, kinks=KINKS, bound=bound)
     mu = np.random.default_rng(1).uniform(0.0, 1.0, 200_000)
     exact = _kinked(mu)[:, 0]
     got = lk(mu)[:, 0]
@@ -278,7 +282,8 @@ def test_lookup_accuracy_bound_and_kink_anchoring(bound):
     assert np.max(np.abs(rel)) <= 3 * LUT_TOL
     # from the requested side, up to rounding (the margin is verified at check points only)
     assert (np.min(rel) >= -1e-12) if bound == "upper" else (np.max(rel) <= 1e-12)
-    assert abs(lk(np.array([0.3]))[0, 0] / 1.0 - 1.0) <= 3 * LUT_TOL  # the kink value itself
+    exact_k = _kinked(np.array(KINKS))[:, 0]
+    assert np.all(np.abs(lk(np.array(KINKS))[:, 0] / exact_k - 1.0) <= 3 * LUT_TOL)
     blind = build_lookup(_kinked, kinks=[], bound=bound)
     assert lk.n_intervals < blind.n_intervals / 2
     assert blind.max_error > 0.0 and lk.epsilon <= 2 * max(lk.max_error, 1e-15) + 1e-14
@@ -291,7 +296,7 @@ def test_lookup_kernel_matches_numpy_and_is_memory_safe():
 
     from brdfkit.pumping import _lookup
 
-    lk = build_lookup(_kinked, kinks=[0.3])
+    lk = build_lookup(_kinked, kinks=KINKS)
     p = np.concatenate([[7.0, 8.0], lk.packed(0)])  # the lookup at an offset, as in a row
 
     @numba.njit
