@@ -129,27 +129,30 @@ Evaluation: one lookup for a whole chain
 ----------------------------------------
 The kernel of a pumped model runs on every pair, so its table reads must cost
 less than the base model (issue target: ≤ 1.3 × the base's time). The spline
-above, in w, needs two square roots per read; the kernels instead read a
-:class:`Lookup` derived from it: piecewise *linear* in μ = cos θ on two
-levels (cell ``int(μ·M)``, then a uniform grid inside the cell, anchored so
-that the function's kinks are nodes), within ``LUT_TOL`` (5e-7, relative) of
-the table, with a margin that keeps the bound on the safe side. And when the
-tabulated albedo is non-decreasing in cos θ — the Phong and Blinn families,
-but not a Fresnel rise at grazing — max(a(L), a(V)) = a(max(N·L, N·V)), and
-N·L, N·V enter g₂ the same way, so every stage's g is a function of
-μ = max(N·L, N·V) alone and k stages collapse into
+above, in w, needs two square roots and a piece search per read; the kernels
+instead read a :class:`Lookup` derived from it: local cubics in μ = cos θ on
+two levels (cell ``int(μ·M)``, then a uniform grid inside the cell, anchored
+so that the function's kinks are nodes), within ``LUT_TOL`` (5e-7, relative)
+of the table, with a margin that keeps the bound on the safe side. And when
+the tabulated albedo is non-decreasing in cos θ — the Phong and Blinn
+families, but not a Fresnel rise at grazing — max(a(L), a(V)) =
+a(max(N·L, N·V)), and N·L, N·V enter g₂ the same way, so every stage's g is a
+function of μ = max(N·L, N·V) alone and k stages collapse into
 
     f⁽ᵏ⁾(L, V) = f(L, V) · q(μ),   q(μ) = 1 / ∏ⱼ gⱼ(μ),
 
-one lookup however many pumpings (:class:`PumpedBRDF` attribute
-``chained``; where the table dips by up to ``CHAIN_DIP_TOL`` while cos θ
-grows — a rounding ripple — g is raised by the depth of the dip, which keeps
-max(a(L), a(V)) ≤ g(max(N·L, N·V)) without adding kinks). A stage whose albedo is not monotone
-wraps the previous kernel with two lookups, as eq. (20) is written. The
-lookup of q bounds it from below, the lookup of a from above, and the cap
-g ≤ 1 is applied in the kernel after the read, so the kernel's f* never
-exceeds the stage-by-stage definition with the tables (a* ≤ 1 is kept) and
-pumping never lowers f.
+one lookup however many pumpings (:class:`PumpedBRDF` attribute ``chained``;
+where a table dips by up to ``CHAIN_DIP_TOL`` while cos θ grows — a rounding
+ripple — its g is raised by the depth of the dip, which keeps
+max(a(L), a(V)) ≤ g(max(N·L, N·V)) without adding kinks). A stage whose
+albedo is not monotone wraps the previous kernel with two lookups, as
+eq. (20) is written. The lookup of q bounds it from below, the lookup of a
+from above, and the cap g ≤ 1 is re-applied in the kernel after the read
+(the margin may cross it), so the kernel's f* never exceeds the
+stage-by-stage definition with the tables (a* ≤ 1 is kept) and pumping never
+lowers f. Finally a pumped model evaluates through its own compiled loop
+with the kernel inlined (:func:`brdfkit.models._base.checked_driver`): called
+through the generic loop, the composite kernel stayed an out-of-line call.
 
 Public objects
 --------------
