@@ -569,7 +569,25 @@ def test_bad_input(phong):
 
 
 def test_cli_pump(phong):
+    import json
+
+    from click.testing import CliRunner
+
+    from brdfkit.cli import main
     from brdfkit.cli._common import build_model
 
     m = build_model("modified-phong", ["n=20", "rho_d=0", "rho_s=1"], pump="controlled", times=2)
     assert isinstance(m, PumpedBRDF) and m.stages == ["controlled", "controlled"]
+    # the example: the JSON says what was evaluated, pumping included
+    args = ["modified-phong", "-p", "n=20", "-p", "rho_d=0", "-p", "rho_s=1",
+            "--pump", "controlled", "--times", "2", "--json"]
+    res = CliRunner().invoke(main, ["albedo", *args, "--theta", "0,60"])
+    assert res.exit_code == 0, res.output
+    out = json.loads(res.output)
+    assert out["pump"] == {"g": "controlled", "times": 2}
+    assert out["albedo"][1] >= _alb(m.root, [np.radians(60.0)])[0]  # pumped up
+    res = CliRunner().invoke(main, ["eval", *args, "--wi", "30,0", "--wo", "30,180"])
+    assert res.exit_code == 0 and json.loads(res.output)["pump"]["times"] == 2
+    res = CliRunner().invoke(main, ["check", *args])
+    out = json.loads(res.output)
+    assert out["pump"]["g"] == "controlled" and out["energy"] == "conserves" and out["reciprocal"]

@@ -73,6 +73,8 @@ class Verdict:
     albedo_error: float = 0.0
     min_albedo: float = 0.0
     theta_min_deg: float = 0.0
+    #: The pumping stages of a pumped model (``PumpedBRDF.to_dict()["pump"]``), else None.
+    pump: dict | list | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready dict with the keys of ``brdfkit check --json``."""
@@ -94,6 +96,7 @@ class Verdict:
             "albedo_error": float(self.albedo_error),
             "min_albedo": float(self.min_albedo),
             "theta_min_deg": float(self.theta_min_deg),
+            **({"pump": self.pump} if self.pump is not None else {}),
         }
 
 
@@ -248,4 +251,5 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
         divergence_exponent=p_rounded, max_scale=max_scale, notes=notes, grazing=grazing,
         slopes=slopes_worst, peaks_at_normal=peaks, albedo_error=err,
         min_albedo=float(a.min(axis=1)[kmin]), theta_min_deg=float(grid[kmin]),
+        pump=d.get("pump"),
     )

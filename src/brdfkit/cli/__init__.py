@@ -133,7 +133,8 @@ def eval_cmd(model: str, param: tuple[str, ...], pump: str | None, times: int, w
     value = m.eval(vi, vo)
     if as_json:
         d = m.to_dict() if hasattr(m, "to_dict") else {"model": model, "params": {}}
-        emit_json({"model": d["model"], "params": d["params"], "value": value})
+        emit_json({"model": d["model"], "params": d["params"],
+                   **({"pump": d["pump"]} if "pump" in d else {}), "value": value})
         return
     v = value.tolist() if hasattr(value, "tolist") else value
     click.echo(" ".join(repr(float(x)) for x in v) if isinstance(v, list) else repr(float(v)))

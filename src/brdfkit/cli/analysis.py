@@ -83,10 +83,11 @@ def albedo_cmd(model, param, pump, times, theta, tol, as_json, as_csv, plot):
     a = np.asarray(r.albedo)
     e = np.asarray(r.error)
     if plot:
-        _plot_albedo(th, a, d["model"], plot)
+        _plot_albedo(th, a, getattr(m, "name", d["model"]), plot)
     if as_json:
-        emit_json({"model": d["model"], "params": d["params"], "theta_deg": th,
-                   "albedo": a, "error": e})
+        emit_json({"model": d["model"], "params": d["params"],
+                   **({"pump": d["pump"]} if "pump" in d else {}),
+                   "theta_deg": th, "albedo": a, "error": e})
         return
     coloured = a.ndim == 2
     if as_csv:
