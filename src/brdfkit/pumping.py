@@ -283,10 +283,6 @@ class AlbedoTable:
         The angles of incidence of the nodes (radians).
     n_evaluations : int
         Albedo engine evaluations spent building the table.
-    nondecreasing : ndarray of bool, shape (C,)
-        Whether the spline is non-decreasing in cos θ on every interval (its
-        derivative, a quadratic, checked at the ends and the vertex); then
-        max(a(L), a(V)) = a(max(N·L, N·V)) and the kernel looks up once.
     coloured : bool
         Whether the model returns a channel axis.
     """
@@ -301,7 +297,6 @@ class AlbedoTable:
     theta_nodes: np.ndarray
     n_evaluations: int
     coloured: bool
-    nondecreasing: np.ndarray
 
     @property
     def n_intervals(self) -> int:
@@ -440,26 +435,13 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
                        max_midpoint_error=max_err, delta=delta,
                        max_albedo=np.max(maxes, axis=0),
                        theta_nodes=thetas(np.concatenate(all_nodes)), n_evaluations=n_eval,
-                       coloured=coloured, nondecreasing=_nondecreasing(coeffs))
+                       coloured=coloured)
 
 
 def _w_of_mu(mu) -> np.ndarray:
     """Table variable w = √(1 − √(1 − μ)) of μ = cos θ (clamped to [0, 1])."""
     r = np.clip(1.0 - np.asarray(mu, dtype=np.float64), 0.0, 1.0)
     return np.sqrt(1.0 - np.sqrt(r))
-
-
-def _nondecreasing(coeffs: np.ndarray) -> np.ndarray:
-    """Per channel: is every cubic non-decreasing on t ∈ [0, 1]? (derivative ≥ 0)."""
-    c0, c1, c2 = coeffs[..., 0], coeffs[..., 1], coeffs[..., 2]
-    d0 = c2  # derivative 3c0 t² + 2c1 t + c2 at t = 0
-    d1 = 3.0 * c0 + 2.0 * c1 + c2  # at t = 1
-    with np.errstate(divide="ignore", invalid="ignore"):
-        tv = np.where(c0 != 0.0, -c1 / (3.0 * c0), -1.0)  # vertex of the quadratic
-    inside = (tv > 0.0) & (tv < 1.0)
-    dv = np.where(inside, 3.0 * c0 * tv * tv + 2.0 * c1 * tv + c2, 0.0)
-    ok = (d0 >= 0.0) & (d1 >= 0.0) & (dv >= 0.0)
-    return np.all(ok, axis=1)
 
 
 def _crossings(fn: Callable, grid: np.ndarray, values: np.ndarray) -> np.ndarray:
@@ -974,21 +956,21 @@ class PumpedBRDF(BRDF):
         cap 1 and (g₂) where it crosses μ."""
         w = self.table.breaks[:-1]
         out = [1.0 - (1.0 - w * w) ** 2]
-        grid = np.linspace(0.0, 1.0, 4097)
-
-        dip = 0.0 if table_only else float(self._dip[c])
+        if table_only:
+            return out[0]
+        dip = float(self._dip[c])
 
         def a(m):  # as in _divisor
             return _as_2d(self.table.at_cos(m))[:, c:c + 1] + dip
 
-        if table_only:
-            return np.concatenate(out)
+        grid = np.linspace(0.0, 1.0, 4097)
+        a_grid = a(grid)
         cap = 1.0 if self.capped else np.inf
         if self.capped:
-            out.append(_crossings(lambda m: a(m) - 1.0, grid, a(grid) - 1.0))
+            out.append(_crossings(lambda m: a(m) - 1.0, grid, a_grid - 1.0))
         if self.g == "controlled":
             out.append(_crossings(lambda m: np.minimum(a(m), cap) - m[:, None], grid,
-                                  np.minimum(a(grid), cap) - grid[:, None]))
+                                  np.minimum(a_grid, cap) - grid[:, None]))
         return np.concatenate(out)
 
     # ---------------------------------------------------------------- packing
