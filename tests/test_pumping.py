@@ -489,17 +489,26 @@ def test_controlled_radiance_bound_pointwise(name, params):
 
 def test_paper_observations_n20(phong_max, blinn_ctrl):
     """§3.2 for n = 20, quantified with rho_hh (engine quadrature, independent of the
-    tables): Phong (g2 = g1, test above) is worth 2-3 pumpings -- gains 0.23, 0.07, then
-    < 0.02; Blinn's first CONTROLLED pumping gains less than its second (0.115 vs 0.18),
-    contrary to the paper's "does not significantly increase with the second" (docstring)."""
+    tables): Phong (g2 = g1, test above) is worth 2-3 pumpings; Blinn's first CONTROLLED
+    pumping gains less than its second, contrary to the paper's "does not significantly
+    increase with the second" (module docstring has the numbers)."""
     from brdfkit.analysis import hemispherical_albedo
 
     r_p = [float(hemispherical_albedo(m, n=24)[0]) for m in phong_max]
+    # The thresholds are a stated criterion, not values read off this code: a pumping
+    # "is worth it" when it adds >= 5 % of the incident energy to rho_hh, and adds
+    # "not significantly" when < 2 %. "Worth pumping 2 or 3 times" = the first two
+    # pumpings are worth it, the third and fourth are not; the gains diminish.
+    worth, insignificant = 0.05, 0.02
     gain_p = np.diff(r_p)
-    assert gain_p[0] > 0.2 and gain_p[1] > 0.05 and gain_p[2] < 0.02 and gain_p[3] < 0.01
+    assert gain_p[0] > worth and gain_p[1] > worth
+    assert gain_p[2] < insignificant and gain_p[3] < insignificant
+    assert np.all(np.diff(gain_p) < 0.0)
     r_b = [float(hemispherical_albedo(m, n=24)[0]) for m in blinn_ctrl]
     gain_b = np.diff(r_b)
-    assert 0.09 < gain_b[0] < 0.14 and gain_b[1] > 0.15 and gain_b[2] > 0.05
+    # the paper: "does not significantly increase with the second and consecutive" pumpings;
+    # computed: the second gains more than the first, and the second and third are worth it
+    assert 0.0 < gain_b[0] < gain_b[1] and gain_b[1] > worth and gain_b[2] > worth
 
 
 def test_super_metal_g1_vs_g2(blinn, blinn_max, blinn_ctrl, phong, phong_max):
