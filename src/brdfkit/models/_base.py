@@ -223,7 +223,29 @@ def checked_driver(kernel):
 
     @numba.njit(parallel=True)
     def driver(wi, wo, P, out):  # pragma: no cover - compiled
-        return _checked_loop(kernel, wi, wo, P, out)
+        n = wi.shape[0]
+        n_channels = P.shape[0]
+        n_bad = 0
+        if n_channels == 1:
+            p = P[0]  # hoisted, as in eval_pairs_checked
+            for j in numba.prange(n):
+                ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
+                ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
+                if _finite6(ix, iy, iz, ox, oy, oz):
+                    out[j, 0] = kernel(ix, iy, iz, ox, oy, oz, p)
+                else:
+                    out[j, 0] = math.nan
+                    n_bad += 1
+        else:
+            for j in numba.prange(n):
+                ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
+                ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
+                ok = _finite6(ix, iy, iz, ox, oy, oz)
+                for c in range(n_channels):
+                    out[j, c] = kernel(ix, iy, iz, ox, oy, oz, P[c]) if ok else math.nan
+                if not ok:
+                    n_bad += 1
+        return n_bad
 
     return driver
 
@@ -234,11 +256,15 @@ def _finite6(a, b, c, d, e, f) -> bool:
     return (a - a) + (b - b) + (c - c) + (d - d) + (e - e) + (f - f) == 0.0
 
 
-@numba.njit(inline="always")
-def _checked_loop(kernel, wi, wo, P, out):  # pragma: no cover - compiled
-    # the body of eval_pairs_checked and of every checked_driver: inlined into both at
-    # Numba IR level (before the prange becomes a parallel loop), so the kernel is a
-    # first-class argument in the one and an inlinable closure variable in the other
+@numba.njit(parallel=True)
+def eval_pairs_checked(kernel, wi, wo, P, out):  # pragma: no cover - compiled
+    """:func:`eval_pairs` that also tests the directions for NaN/inf in the same pass.
+
+    Pairs with a non-finite component are not passed to the kernel (their
+    ``out`` rows are NaN). Returns the number of such pairs, so that the
+    caller can raise; reading the directions once instead of twice is what
+    makes this faster than ``np.isfinite`` followed by :func:`eval_pairs`.
+    """
     n = wi.shape[0]
     n_channels = P.shape[0]
     n_bad = 0
@@ -264,18 +290,6 @@ def _checked_loop(kernel, wi, wo, P, out):  # pragma: no cover - compiled
                     out[j, c] = math.nan
                 n_bad += 1
     return n_bad
-
-
-@numba.njit(parallel=True)
-def eval_pairs_checked(kernel, wi, wo, P, out):  # pragma: no cover - compiled
-    """:func:`eval_pairs` that also tests the directions for NaN/inf in the same pass.
-
-    Pairs with a non-finite component are not passed to the kernel (their
-    ``out`` rows are NaN). Returns the number of such pairs, so that the
-    caller can raise; reading the directions once instead of twice is what
-    makes this faster than ``np.isfinite`` followed by :func:`eval_pairs`.
-    """
-    return _checked_loop(kernel, wi, wo, P, out)
 
 
 class BRDF:
@@ -315,9 +329,6 @@ class BRDF:
     #: (sharp lobes, grazing-sensitive settings, coloured parameters).
     examples: ClassVar[tuple[dict, ...]] = ({},)
     kernel: Callable
-    #: Compiled loop specialised to ``kernel`` (:func:`checked_driver`), or None for the
-    #: generic :func:`eval_pairs_checked` (a composite kernel, e.g. pumped, sets one).
-    _driver: Callable | None = None
 
     # ------------------------------------------------------------------ set-up
     def __init__(self, **values):
@@ -481,7 +492,7 @@ class BRDF:
         wi2 = np.ascontiguousarray(wi.reshape(-1, 3))
         wo2 = np.ascontiguousarray(wo.reshape(-1, 3))
         out = np.empty((wi2.shape[0], self._packed.shape[0]))
-        driver = self._driver
+        driver = getattr(self, "_driver", None)
         n_bad = (driver(wi2, wo2, self._packed, out) if driver is not None
                  else eval_pairs_checked(self.kernel, wi2, wo2, self._packed, out))
         if n_bad:
