@@ -60,6 +60,7 @@ import numba
 import numpy as np
 
 from brdfkit.errors import BrdfkitError, ParameterError
+from brdfkit.models._base import BRDF
 
 __all__ = ["AlbedoResult", "albedo", "albedo_mc", "hemispherical_albedo", "H_s", "lobe_frame"]
 
@@ -673,10 +674,10 @@ MAX_KINKS = 12
 def _declared_kinks(model, flat: np.ndarray) -> np.ndarray | None:
     """The model's ``albedo_kinks_nv(theta) -> (T, K)`` levels k of N·V where its
     integrand has a kink (NaN: none), or None."""
-    fn = getattr(model, "albedo_kinks_nv", None)
-    if not callable(fn):
+    kv = model.albedo_kinks_nv(flat)
+    if kv is None:
         return None
-    kv = np.asarray(fn(flat), dtype=np.float64).reshape(flat.size, -1)
+    kv = np.asarray(kv, dtype=np.float64).reshape(flat.size, -1)
     if kv.shape[1] > MAX_KINKS:
         # keep the engine's break-point arrays small: the rest is left to refinement
         kv = kv[:, :MAX_KINKS]
@@ -780,17 +781,17 @@ def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
             return vals
 
         a, e, _ = _integrate(evaluate, flat, m_mode, m_width, sym, tol, P.shape[0],
-                             _has_nvnl_kink(model), _declared_kinks(model, flat))
+                             _has_nvnl_kink(model),
+                             _declared_kinks(model, flat) if isinstance(model, BRDF) else None)
         coloured = getattr(model, "n_channels", None) is not None
     elif callable(model):
         a, e, coloured = _albedo_callable(model, flat, m_mode, m_width, tol)
     else:
         raise BrdfkitError(f"albedo: model must be a BRDF or a callable f(wi, wo); got "
                            f"{type(model).__name__}")
-    spec = getattr(model, "specular_albedo", None)
-    if callable(spec):
-        extra = np.asarray(spec(flat), dtype=np.float64).reshape(flat.size, -1)
-        a = a + extra
+    extra = model.specular_albedo(flat) if isinstance(model, BRDF) else None
+    if extra is not None:
+        a = a + np.asarray(extra, dtype=np.float64).reshape(flat.size, -1)
     if coloured:
         shape = th.shape + (a.shape[1],)
     else:
@@ -882,9 +883,9 @@ def albedo_mc(model, theta_i, *, n_samples: int = 100_000, rng=None,
         vals_e.append(est.std(axis=0, ddof=1) / math.sqrt(n_samples))
     a = np.array(vals_a)
     e = np.array(vals_e)
-    spec = getattr(model, "specular_albedo", None)
-    if callable(spec):
-        a = a + np.asarray(spec(th.reshape(-1)), dtype=np.float64).reshape(a.shape[0], -1)
+    extra = model.specular_albedo(th.reshape(-1)) if isinstance(model, BRDF) else None
+    if extra is not None:
+        a = a + np.asarray(extra, dtype=np.float64).reshape(a.shape[0], -1)
     if getattr(model, "n_channels", None) is None and a.shape[1] == 1:
         return AlbedoResult(th.copy(), a[:, 0].reshape(th.shape), e[:, 0].reshape(th.shape))
     return AlbedoResult(th.copy(), a.reshape(th.shape + (-1,)), e.reshape(th.shape + (-1,)))

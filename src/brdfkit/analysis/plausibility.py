@@ -240,7 +240,7 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
                          f"{100 * a_graze / max_a:.2g}% of its maximum (Neumann §1.2)")
     if not asym <= RECIPROCITY_TOL:
         notes.append(f"not reciprocal: max relative asymmetry {asym:.3g}")
-    if hasattr(model, "specular_albedo"):
+    if model.has_delta:
         notes.append("includes the energy of the specular delta term (specular_albedo)")
 
     kmin = int(np.argmin(a.min(axis=1)[grid <= 89.0]))

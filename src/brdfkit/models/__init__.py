@@ -10,7 +10,7 @@ One module per family; every model is registered in :data:`MODELS`.
   He–Torrance and the modern Walter et al. microfacet model.
 """
 
-from brdfkit.models._base import BRDF, Lobe, Param, eval_pairs
+from brdfkit.models._base import BRDF, DerivedBRDF, Lobe, Param, eval_pairs
 from brdfkit.models._registry import MODELS, model, model_names, register, resolve
 
 # Importing the family modules registers their models, in this order: the order of
@@ -19,5 +19,5 @@ from brdfkit.models._registry import MODELS, model, model_names, register, resol
 from brdfkit.models import diffuse, phong, microfacet  # noqa: E402,F401
 # isort: on
 
-__all__ = ["BRDF", "Lobe", "MODELS", "Param", "eval_pairs", "model", "model_names", "register",
+__all__ = ["BRDF", "DerivedBRDF", "Lobe", "MODELS", "Param", "eval_pairs", "model", "model_names", "register",
            "resolve"]

@@ -25,7 +25,8 @@ what lets brdfkit beat Mitsuba 3 end to end (see ``benchmarks/``).
 Public objects
 --------------
 - :class:`Param` — a declared parameter.
-- :class:`BRDF` — the base class of all models.
+- :class:`BRDF` — the base class of all models; it declares the model protocol.
+- :class:`DerivedBRDF` — the one constructor path for models built from others.
 - :func:`eval_pairs` — the compiled driver (for code that has packed arrays).
 - :func:`eval_pairs_checked` — the same, also testing the directions for NaN/inf
   in the same pass (what :meth:`BRDF.eval` uses).
@@ -47,7 +48,8 @@ from brdfkit._array import as_directions, as_uniform
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.geometry import pdf_cosine_hemisphere, sample_cosine_hemisphere
 
-__all__ = ["Param", "Lobe", "BRDF", "checked_driver", "eval_pairs", "eval_pairs_checked"]
+__all__ = ["Param", "Lobe", "BRDF", "DerivedBRDF", "checked_driver", "eval_pairs",
+           "eval_pairs_checked"]
 
 
 @dataclass(frozen=True)
@@ -318,6 +320,28 @@ class BRDF:
         True when :meth:`sample` follows the lobe (not the cosine fallback).
     width_param : str or None
         The parameter that a half-angle ``beta`` (radians) converts to.
+
+    The model protocol
+    ------------------
+    Everything an engine (albedo, plausibility, pumping, sampling tests,
+    renderers, fitting, the explorer) needs from a model is declared here, with
+    a default; engines read only these and never name a model:
+
+    - :attr:`isotropic` — f depends on the azimuths only through their
+      difference and is mirror-symmetric about the plane of incidence.
+    - :attr:`kernel`, :attr:`packed`, :attr:`n_channels` — the compiled formula
+      and its packed parameters (``kernel is None``: the model evaluates in
+      :meth:`eval` itself, e.g. a pumped model with a user g).
+    - :meth:`lobes` and :meth:`sharpest_lobe` — where the energy concentrates
+      (the one reading of :meth:`lobes` every engine uses).
+    - :attr:`albedo_kinks`, :meth:`albedo_kinks_nv`, :attr:`albedo_kink_mus` —
+      kinks the albedo engine and the pumping tables make break points.
+    - :attr:`has_delta`, :meth:`specular_albedo` — a specular delta term that
+      is not in the kernel.
+    - :attr:`reciprocal`, :attr:`has_sampler`, :meth:`sample`, :meth:`pdf`.
+
+    Models built from other models (pumped, measured, fitted, wrapped) derive
+    from :class:`DerivedBRDF`, which passes through the same set-up.
     """
 
     name: ClassVar[str] = ""
@@ -332,7 +356,25 @@ class BRDF:
     #: properties, albedo cross-checks): a typical one first, then extreme ones
     #: (sharp lobes, grazing-sensitive settings, coloured parameters).
     examples: ClassVar[tuple[dict, ...]] = ({},)
-    kernel: Callable
+    #: The compiled scalar kernel ``kernel(ix, iy, iz, ox, oy, oz, p) -> float`` (module
+    #: docstring); None for a model that evaluates in NumPy (it overrides :meth:`eval`).
+    kernel: Callable | None = None
+    #: Whether f(ω_i, ω_o) depends on the azimuths only through φ_i − φ_o and is even in
+    #: it (mirror symmetry about the plane of incidence). The albedo engine then integrates
+    #: half the azimuths and doubles; pumping needs it (the albedo is a function of θ_i).
+    isotropic: ClassVar[bool] = True
+    #: Kinks of ω_o ↦ f(ω_i, ω_o) on curves known in closed form, made panel edges by the
+    #: albedo engine in every frame: ``"nv=nl"`` (a max(N·L, N·V) in the formula, e.g.
+    #: Neumann eq. 22) and ``"vgroove"`` (the branches of the V-groove shadowing
+    #: G = min(1, 2(N·H)(N·V)/(V·H), 2(N·H)(N·L)/(L·H)) cross). Unlisted kinks are left to
+    #: the engine's refinement, which then costs more nodes.
+    albedo_kinks: ClassVar[frozenset[str]] = frozenset()
+    #: cos θ_i where the directional albedo a(θ_i) itself has a kink (for tables of it,
+    #: e.g. the pumping tables); () when a is smooth.
+    albedo_kink_mus: tuple[float, ...] = ()
+    #: Whether the model has a specular delta term that is not in :attr:`kernel` (its
+    #: energy is :meth:`specular_albedo`).
+    has_delta: ClassVar[bool] = False
     #: Compiled loop specialised to ``kernel`` (:func:`checked_driver`), or None for the
     #: generic :func:`eval_pairs_checked` (a composite kernel, e.g. pumped, sets one).
     _driver: Callable | None = None
@@ -358,6 +400,12 @@ class BRDF:
                     f"{self.name}: give either 'beta' or {self.width_param!r}, not both"
                 )
             values[self.width_param] = self.width_from_beta(_check_beta(self.name, beta))
+        self._setup(values)
+
+    def _setup(self, values: dict) -> None:
+        """The set-up every model passes through, registered or derived: validate each
+        declared parameter (defaults for the missing ones), check per-lobe and per-channel
+        lengths, the subclass's cross-parameter checks, then pack the kernel's rows."""
         self._values: dict = {}
         for p in self.params:
             v = values.get(p.name, p.default)
@@ -436,6 +484,49 @@ class BRDF:
     def lobes(self) -> list[Lobe]:
         """The lobes of this parameterisation (see :class:`Lobe`); default: one diffuse."""
         return [Lobe("diffuse", math.pi / 2)]
+
+    def sharpest_lobe(self) -> Lobe:
+        """The lobe that sets the resolution of every numerical engine.
+
+        The one reading of :meth:`lobes` (albedo quadrature frame, χ² binning,
+        table grids): the width is the smallest width of all lobes (π/2 at most;
+        a non-finite or non-positive width counts as π/2); the kind is that
+        lobe's, except that a ``mirror`` or ``half`` lobe, where the model has
+        one, wins over a sharper ``normal``/``diffuse`` one (the directional
+        lobe's frame places its peak and horizon cut exactly; a narrow lobe
+        about the normal is still resolved there by the width). No lobes:
+        ``Lobe("diffuse", π/2)``.
+        """
+        lobes = list(self.lobes())
+        if not lobes:
+            return Lobe("diffuse", math.pi / 2)
+        best = min(lobes, key=lambda lb: lb.width)
+        width = float(best.width)
+        if not math.isfinite(width) or width <= 0.0:
+            width = math.pi / 2
+        kind = best.kind
+        if kind in ("normal", "diffuse"):
+            kind = next((lb.kind for lb in lobes if lb.kind in ("mirror", "half")), kind)
+        return Lobe(kind, min(width, math.pi / 2))
+
+    def albedo_kinks_nv(self, theta) -> np.ndarray | None:
+        """Levels k of N·V where ω_o ↦ f(ω_i, ω_o) has a kink, per incidence angle.
+
+        For θ_i in *theta* (radians, 1-D), shape ``(T, K)``: up to 12 levels k
+        per angle (NaN: none) of circles N·V = k that the albedo engine makes
+        panel edges (e.g. where a pumped model's g switches branch). Default:
+        None (no such kinks).
+        """
+        return None
+
+    def specular_albedo(self, theta_i) -> np.ndarray | None:
+        """Albedo of the specular delta term not in :attr:`kernel` at θ_i (radians).
+
+        Shape ``theta_i.shape`` (+ ``(C,)`` when coloured). The albedo engine
+        adds it to the integral of the kernel. Default (``has_delta`` false):
+        None.
+        """
+        return None
 
     # --------------------------------------------------------------- accessors
     @property
@@ -548,6 +639,64 @@ class BRDF:
             "has_sampler": cls.has_sampler,
             "beta": cls.width_param,
             "params": [p.to_dict() for p in cls.params],
+        }
+
+
+class DerivedBRDF(BRDF):
+    """A model built from another one: pumped, measured, fitted or wrapped.
+
+    The one constructor path for derived models: what a registered model class
+    declares as class attributes (name, parameters, citation, claims) a derived
+    model receives as arguments, per instance, and then passes through the same
+    set-up as every model (:meth:`BRDF._setup`: parameter validation, channel
+    count, packing). So a derived model is a model by construction: evaluate,
+    sample, analyse, pump, fit, render. Subclasses build what their kernel needs
+    (tables, lookups) *before* calling ``super().__init__`` (which packs), and
+    override :meth:`with_params`, :meth:`to_dict` and :meth:`__repr__`.
+
+    Parameters (keyword-only)
+    -------------------------
+    name, citation, summary : str
+        As the class attributes of :class:`BRDF`.
+    params : sequence of Param
+        The parameters this model exposes (e.g. a pumped model: its root's).
+    values : dict
+        Their values (validated again against *params*).
+    reciprocal, has_sampler, isotropic, has_delta : bool
+        The model's claims (see :class:`BRDF`).
+    width_param : str or None
+        The parameter a half-angle ``beta`` converts to.
+    kernel : compiled kernel or None
+        None: the subclass overrides :meth:`eval`.
+    """
+
+    def __init__(self, *, name: str, params, values: dict, citation: str = "",
+                 summary: str = "", reciprocal: bool, has_sampler: bool = False,
+                 isotropic: bool = True, has_delta: bool = False,
+                 width_param: str | None = None, kernel: Callable | None = None):
+        self.name = str(name)
+        self.params = tuple(params)
+        self.citation = citation
+        self.summary = summary
+        self.reciprocal = bool(reciprocal)
+        self.has_sampler = bool(has_sampler)
+        self.isotropic = bool(isotropic)
+        self.has_delta = bool(has_delta)
+        self.width_param = width_param
+        self.kernel = kernel
+        self._setup(dict(values))
+
+    def describe(self) -> dict:  # an instance method here: the declarations are per instance
+        """JSON-ready description of this model (as :meth:`BRDF.describe`)."""
+        return {
+            "name": self.name,
+            "aliases": [],
+            "summary": self.summary,
+            "citation": self.citation,
+            "reciprocal": self.reciprocal,
+            "has_sampler": self.has_sampler,
+            "beta": self.width_param,
+            "params": [p.to_dict() for p in self.params],
         }
 
 

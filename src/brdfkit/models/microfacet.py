@@ -621,6 +621,7 @@ class TorranceSparrow(_HalfVectorSampling, BRDF):
         ETA_DIELECTRIC,
     )
     citation = "Lewis 1993 eq. (10) with D1-D4 and G of §3.2 (after Cook & Torrance 1982)"
+    albedo_kinks = frozenset({"vgroove"})  # G of §3.2
     reciprocal = True
     has_sampler = True
     width_param = "m"  # of the default distribution; per instance it follows `distribution`
@@ -786,6 +787,7 @@ class CookTorrance(_HalfVectorSampling, BRDF):
         Param("rho_s", 1.0, 0.0, 1.0, "", "specular scale", kind="colour"),
     )
     citation = "Neumann et al. 1999 eqs. (9)-(10) (Cook & Torrance 1982)"
+    albedo_kinks = frozenset({"vgroove"})  # G of eq. (10)
     reciprocal = True
     has_sampler = True
     width_param = "m"
@@ -1113,6 +1115,7 @@ class HeTorrance(_HalfVectorSampling, BRDF):
     )
     citation = ("He, Torrance, Sillion, Greenberg 1991 (rho_dd, rho_sp, sigma, S); "
                 "Neumann et al. 1999 Fig. 1 (sigma0 = 0.1, tau = 1.7)")
+    has_delta = True  # the specular spike of eq. (5): specular_albedo
     reciprocal = True
     has_sampler = True
     kernel = _he_torrance

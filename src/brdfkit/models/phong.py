@@ -1158,6 +1158,7 @@ class NeumannPhong(_MixtureSampled):
         N_EXP,
     )
     citation = "Neumann et al. 1999 eq. (22)"
+    albedo_kinks = frozenset({"nv=nl"})  # the max(N·L, N·V) denominator of eq. (22)
     reciprocal = True
     width_param = "n"
     kernel = _neumann_phong
