@@ -62,9 +62,15 @@ import numpy as np
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models._base import BRDF
 
-__all__ = ["AlbedoResult", "albedo", "albedo_mc", "hemispherical_albedo", "H_s", "lobe_frame"]
+__all__ = ["AlbedoResult", "albedo", "albedo_mc", "hemispherical_albedo", "H_s", "lobe_frame",
+           "STATUS_MESSAGES", "CONVERGED", "MAX_LEVEL_REACHED", "NODE_CAP", "NONFINITE"]
 
 NORMAL, MIRROR, HALF = 0, 1, 2
+#: Bits of the ``kinks`` flags passed to the node generators, from the model's declared
+#: :attr:`~brdfkit.models.BRDF.albedo_kinks`: the curve N·V = N·L (a max(N·L, N·V) in the
+#: formula) and the three curves where the branches of the V-groove G cross.
+KINK_NVNL, KINK_VGROOVE = 1, 2
+_KINK_BITS = {"nv=nl": KINK_NVNL, "vgroove": KINK_VGROOVE}
 _MODE = {"diffuse": NORMAL, "normal": NORMAL, "mirror": MIRROR, "half": HALF}
 MAX_LEVEL = 5
 GRADE = 2.0  # geometric grading of the t panels: w, 2w, 4w, 8w, then x4
@@ -122,7 +128,7 @@ def _k2_cos(t, s, c):
 
 
 @numba.njit(cache=True)
-def _t_breaks(mode, theta, width, out, kv):
+def _t_breaks(mode, theta, width, out, kv, kinks):
     """Sorted break points of the t axis (including 0 and t_max); returns their count."""
     tmax = _t_max(mode, theta)
     e = 0.5 * math.pi - theta  # elevation of ω_i (and of R) above the horizon
@@ -139,10 +145,12 @@ def _t_breaks(mode, theta, width, out, kv):
         n += 3
     elif mode == HALF:
         cand[n] = 0.5 * e  # the half-vector circle first maps below the horizon
-        cand[n + 1] = e  # V-groove kink 2(N·H)(N·L) = L·H reaches φ = 0
-        cand[n + 2] = theta  # V-groove kink N·V = N·L reaches φ = 0
-        cand[n + 3] = 0.25 * math.pi  # the three V-groove kink curves cross (2cos²t = 1)
-        n += 4
+        n += 1
+    if mode == HALF and kinks & KINK_VGROOVE:
+        cand[n] = e  # V-groove kink 2(N·H)(N·L) = L·H reaches φ = 0
+        cand[n + 1] = theta  # V-groove kink N·V = N·L reaches φ = 0
+        cand[n + 2] = 0.25 * math.pi  # the three V-groove kink curves cross (2cos²t = 1)
+        n += 3
         # V-groove kink 2(N·H)(N·V) = V·H reaches φ = 0 or π: roots of k₂(t) = ±1
         s_ = math.sin(theta)
         c_ = math.cos(theta)
@@ -212,11 +220,12 @@ def _t_breaks(mode, theta, width, out, kv):
 
 
 @numba.njit(cache=True)
-def _phi_breaks(mode, t, s, c, level, out, nvnl, kv):
+def _phi_breaks(mode, t, s, c, level, out, kinks, kv):
     """Break points 0 = b₀ < … < b_k = φ_max of the azimuth at polar angle t; returns k + 1.
 
-    φ_max is where ω_o meets the horizon (closed form). In half-vector mode
-    the azimuths where the branches of the V-groove G cross are added:
+    φ_max is where ω_o meets the horizon (closed form). In half-vector mode,
+    for a model declaring the ``vgroove`` kink, the azimuths where the branches
+    of the V-groove G cross are added:
     2(N·H)(N·L) = L·H, 2(N·H)(N·V) = V·H, and N·V = N·L, each of the form
     cos φ = (d* − c cos t)/(s sin t) for the value d* of ω_i·h on that curve.
     The curves N·V = k for the levels k in ``kv`` (model-declared kinks, see
@@ -249,7 +258,8 @@ def _phi_breaks(mode, t, s, c, level, out, nvnl, kv):
             phimax = math.acos(c0)
     out[0] = 0.0
     k = 1
-    if mode == MIRROR and (level >= 1 or nvnl) and s * st > 1e-300 and phimax > 0.0:
+    if mode == MIRROR and (level >= 1 or kinks & KINK_NVNL) and s * st > 1e-300 \
+            and phimax > 0.0:
         # N·V = N·L: c cos t + s sin t cos φ = c ⇔ cos φ = (c/s) tan(t/2); kink of
         # max(N·L, N·V) denominators (Neumann eq. 22). Only from the first refinement
         # on: most mirror-lobe models are smooth there, and level 0 is the fast path.
@@ -279,7 +289,7 @@ def _phi_breaks(mode, t, s, c, level, out, nvnl, kv):
                 if not dup and 1e-12 < ph < phimax - 1e-12:
                     out[k] = ph
                     k += 1
-    if mode == HALF and s * st > 1e-300 and phimax > 0.0:
+    if mode == HALF and kinks & KINK_VGROOVE and s * st > 1e-300 and phimax > 0.0:
         dstar = np.empty(3)
         nd = 0
         dstar[nd] = 2.0 * ct * c  # 2(N·H)(N·L) = L·H
@@ -340,11 +350,11 @@ def _direction(mode, st, ct, phi, s, c):
 
 
 @numba.njit(cache=True)
-def _count_nodes(mode, theta, width, level, sym, X, nvnl, kv):
+def _count_nodes(mode, theta, width, level, sym, X, kinks, kv):
     """Exact number of nodes :func:`_gen_nodes` writes, and the number of error pieces."""
     tb = np.empty(64)
     pb = np.empty(16 + kv.shape[0])
-    nt = _t_breaks(mode, theta, width, tb, kv)
+    nt = _t_breaks(mode, theta, width, tb, kv, kinks)
     sub = 1 << level
     n_int = (5 if mode == HALF else 2) + kv.shape[0]
     halves = 1 if sym else 2
@@ -356,13 +366,13 @@ def _count_nodes(mode, theta, width, level, sym, X, nvnl, kv):
             a = tb[ip] + (tb[ip + 1] - tb[ip]) * q / sub
             b = tb[ip] + (tb[ip + 1] - tb[ip]) * (q + 1) / sub
             for it in range(15):
-                k = _phi_breaks(mode, a + (b - a) * X[it], s, c, level, pb, nvnl, kv)
+                k = _phi_breaks(mode, a + (b - a) * X[it], s, c, level, pb, kinks, kv)
                 n += min(k - 1, n_int) * sub * 15 * halves
     return n, (nt - 1) * sub * halves
 
 
 @numba.njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract"})
-def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, nvnl, kv):
+def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, kinks, kv):
     """Fill the nodes of one incidence angle; returns the number written.
 
     wo (N, 3), wk / wg (N,) Kronrod / Gauss weights including the measure and
@@ -371,7 +381,7 @@ def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, nvn
     s = math.sin(theta)
     c = math.cos(theta)
     tb = np.empty(64)
-    nt = _t_breaks(mode, theta, width, tb, kv)
+    nt = _t_breaks(mode, theta, width, tb, kv, kinks)
     sub = 1 << level
     n_int = (5 if mode == HALF else 2) + kv.shape[0]
     halves = 1 if sym else 2
@@ -387,7 +397,7 @@ def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, nvn
                 t = a + (b - a) * X[it]
                 wtk = WK[it] * (b - a)
                 wtg = WG[it] * (b - a)
-                k = _phi_breaks(mode, t, s, c, level, pb, nvnl, kv)
+                k = _phi_breaks(mode, t, s, c, level, pb, kinks, kv)
                 st = math.sin(t)
                 ct = math.cos(t)
                 for h in range(halves):
@@ -452,13 +462,13 @@ def _reduce(vals, wk, wg, piece, n_pieces, n, C, out_a, out_e):
 
 
 def _gen_all_py(mode, thetas, width, levels, sym, X, WK, WG, offsets, wo, wk, wg, piece,
-                nvnl, kvs):
+                kinks, kvs):
     """Nodes of every angle i at its level, written at offsets[i] (parallel over angles)."""
     for i in numba.prange(thetas.shape[0]):
         o = offsets[i]
         m = offsets[i + 1] - o
         n = _gen_nodes(mode, thetas[i], width, levels[i], sym, X, WK, WG, wo[o:o + m],
-                       wk[o:o + m], wg[o:o + m], piece[o:o + m], nvnl, kvs[i])
+                       wk[o:o + m], wg[o:o + m], piece[o:o + m], kinks, kvs[i])
         for j in range(n, m):  # unused slots (absent azimuth intervals): weight 0
             wo[o + j, 0] = 0.0
             wo[o + j, 1] = 0.0
@@ -490,8 +500,9 @@ PARALLEL_NODES = 2_000_000
 # Serial: compiles in ~0.3 s per model instead of ~1 s for a prange loop (this
 # matters for Table 2, which compiles it for every registered model).
 @numba.njit
-def _eval_kernel(kernel, P, thetas, offsets, wo, vals):  # pragma: no cover - compiled
-    """vals[j, c] = kernel(ω_i(θ of j), wo[j], P[c]); NaN/inf replaced by 0."""
+def _eval_kernel(kernel, P, thetas, offsets, wo, vals, bad):  # pragma: no cover - compiled
+    """vals[j, c] = kernel(ω_i(θ of j), wo[j], P[c]); bad[i] counts the non-finite values of
+    angle i (stored as 0 so that they cannot poison the sums of the other angles)."""
     for i in range(thetas.shape[0]):
         ix = math.sin(thetas[i])
         iz = math.cos(thetas[i])
@@ -501,49 +512,70 @@ def _eval_kernel(kernel, P, thetas, offsets, wo, vals):  # pragma: no cover - co
                     vals[j, ch] = 0.0
                     continue
                 v = kernel(ix, 0.0, iz, wo[j, 0], wo[j, 1], wo[j, 2], P[ch])
-                vals[j, ch] = v if math.isfinite(v) else 0.0  # guard: never propagate NaN
+                if math.isfinite(v):
+                    vals[j, ch] = v
+                else:
+                    vals[j, ch] = 0.0
+                    bad[i] += 1
 
 
 @numba.njit
-def _eval_pairs_guarded(kernel, wi, wo, P, out):  # pragma: no cover - compiled
-    """:func:`brdfkit.models.eval_pairs` for the integrator: serial (cheaper to compile,
-    see :func:`_eval_kernel`) and with NaN/inf replaced by 0, so one bad node of a user
-    callable cannot poison a whole albedo."""
+def _eval_pairs_serial(kernel, wi, wo, P, out):  # pragma: no cover - compiled
+    """:func:`brdfkit.models.eval_pairs` for the analyses: serial (cheaper to compile, see
+    :func:`_eval_kernel`), no direction checks (the analyses build unit directions)."""
     for j in range(wi.shape[0]):
         for ch in range(P.shape[0]):
-            v = kernel(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2], P[ch])
-            out[j, ch] = v if math.isfinite(v) else 0.0
+            out[j, ch] = kernel(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2],
+                                P[ch])
 
 
 def evaluate_pairs(model, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
-    """f_r(wi, wo) for (N, 3) arrays → (N, C) (C = 1 for scalar models).
+    """f_r(wi, wo) for (N, 3) arrays → (N, C) (C = 1 for scalar models), values as computed
+    (a non-finite value is returned, not hidden).
 
-    Compiled models run their kernel directly; anything else is called.
+    Models with a compiled kernel run it directly (serial); other models through
+    :meth:`~brdfkit.models.BRDF.eval`; plain callables are called.
     """
     wi = np.ascontiguousarray(np.broadcast_to(wi, np.broadcast_shapes(wi.shape, wo.shape)),
                               dtype=np.float64)
     wo = np.ascontiguousarray(np.broadcast_to(wo, wi.shape), dtype=np.float64)
-    if _is_compiled(model):
+    if isinstance(model, BRDF) and model.kernel is not None:
         P = np.ascontiguousarray(np.asarray(model.packed, dtype=np.float64))
         out = np.empty((wi.shape[0], P.shape[0]))
-        _eval_pairs_guarded(model.kernel, wi, wo, P, out)
+        _eval_pairs_serial(model.kernel, wi, wo, P, out)
         return out
-    return np.asarray(model(wi, wo), dtype=np.float64).reshape(wi.shape[0], -1)
+    f = model.eval if isinstance(model, BRDF) else model
+    return np.asarray(f(wi, wo), dtype=np.float64).reshape(wi.shape[0], -1)
 
 
 #: Memory bounds of :func:`_integrate`: nodes evaluated per call of ``evaluate`` (about
 #: 56 + 8C bytes each for a compiled model, ~3x that for a callable) and the most nodes one
 #: angle may use. Level 5 of a sharp mirror lobe needs ~9e6 nodes per angle (a table of 64
 #: angles at once allocated 19 GB before the bound); past the bound the previous level's
-#: result and its error estimate are returned.
+#: result and its error estimate are returned, with status NODE_CAP.
 MAX_CHUNK_NODES = 3_000_000
 MAX_ANGLE_NODES = 6_000_000
 
+#: Status of one angle of an :class:`AlbedoResult` (SciPy-style codes; see
+#: :data:`STATUS_MESSAGES`). Anything but CONVERGED means the error estimate is above the
+#: goal (``max(tol, 1e-10·|a|)``) or, for NONFINITE, that there is no estimate at all.
+CONVERGED, MAX_LEVEL_REACHED, NODE_CAP, NONFINITE = 0, 1, 2, 3
+STATUS_MESSAGES = {
+    CONVERGED: "converged: the error estimate meets the tolerance",
+    MAX_LEVEL_REACHED: f"tolerance not reached after {MAX_LEVEL} refinements (the error "
+                       "estimate is returned; a sharper lobe or a kink the model does not "
+                       "declare)",
+    NODE_CAP: f"tolerance not reached: the next refinement needs more than "
+              f"{MAX_ANGLE_NODES:,} nodes (the error estimate is returned)",
+    NONFINITE: "the integrand is NaN or infinite at some quadrature nodes (albedo NaN)",
+}
 
-def _integrate_chunk(evaluate, th, mode, width, level, sym, nvnl, kvs, counts, npieces, a, e,
-                     idx, tol) -> np.ndarray:
-    """One level for the angles ``th`` (results written to a[idx], e[idx]); returns the
-    mask of angles whose error estimate is still above the goal."""
+
+def _integrate_chunk(evaluate, th, mode, width, level, sym, kinks, kvs, counts, npieces, a, e,
+                     bad, idx, tol) -> np.ndarray:
+    """One level for the angles ``th`` (results written to a[idx], e[idx]; bad[idx] counts
+    non-finite integrand values); returns the mask of angles whose error estimate is still
+    above the goal."""
     th = np.ascontiguousarray(th)
     lv = np.full(th.size, level, dtype=np.int64)
     offsets = np.zeros(th.size + 1, dtype=np.int64)
@@ -555,9 +587,10 @@ def _integrate_chunk(evaluate, th, mode, width, level, sym, nvnl, kvs, counts, n
     piece = np.empty(total, dtype=np.int64)
     big = total >= PARALLEL_NODES
     gen = _gen_all_parallel if big else _gen_all_serial
-    gen(mode, th, width, lv, sym, _X, _WK, _WGAUSS, offsets, wo, wk, wg, piece, nvnl,
+    gen(mode, th, width, lv, sym, _X, _WK, _WGAUSS, offsets, wo, wk, wg, piece, kinks,
         np.ascontiguousarray(kvs))
-    vals = np.ascontiguousarray(evaluate(th, offsets, wo), dtype=np.float64)
+    vals, nbad = evaluate(th, offsets, wo)
+    vals = np.ascontiguousarray(vals, dtype=np.float64)
     del wo
     aa = np.empty((th.size, vals.shape[1]))
     ee = np.empty_like(aa)
@@ -565,32 +598,38 @@ def _integrate_chunk(evaluate, th, mode, width, level, sym, nvnl, kvs, counts, n
     red(vals, wk, wg, piece, offsets, np.ascontiguousarray(npieces), aa, ee)
     a[idx] = aa
     e[idx] = ee
-    return np.any(ee > np.maximum(tol, 1e-10 * np.abs(aa)), axis=1)
+    bad[idx] += nbad
+    return np.any(ee > np.maximum(tol, 1e-10 * np.abs(aa)), axis=1) & (nbad == 0)
 
 
 def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool, tol: float,
-               n_channels: int, nvnl: bool = False, kinks: np.ndarray | None = None
+               n_channels: int, kinks: int = 0, levels_nv: np.ndarray | None = None
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Level loop shared by the compiled and the callable paths.
 
-    ``evaluate(thetas, offsets, wo) -> vals (N, C)`` evaluates f at the nodes.
+    ``evaluate(thetas, offsets, wo) -> (vals (N, C), n_bad (T,))`` evaluates f at the
+    nodes and counts the non-finite values per angle. Returns (albedo, error, status);
+    an angle with non-finite values has albedo NaN, error inf, status NONFINITE.
     """
     n = thetas.size
-    kvs = np.full((n, 0), np.nan) if kinks is None else np.asarray(kinks, dtype=np.float64)
+    kvs = (np.full((n, 0), np.nan) if levels_nv is None
+           else np.asarray(levels_nv, dtype=np.float64))
     a = np.zeros((n, n_channels))
     e = np.full((n, n_channels), np.inf)
-    levels = np.zeros(n, dtype=np.int64)
+    bad = np.zeros(n, dtype=np.int64)
+    status = np.full(n, CONVERGED, dtype=np.int8)
     todo = np.arange(n)
     for level in range(MAX_LEVEL + 1):
         counts = np.empty(todo.size, dtype=np.int64)
         npieces = np.empty(todo.size, dtype=np.int64)
         for k, t in enumerate(thetas[todo]):
-            counts[k], npieces[k] = _count_nodes(mode, float(t), width, level, sym, _X, nvnl,
+            counts[k], npieces[k] = _count_nodes(mode, float(t), width, level, sym, _X, kinks,
                                                  kvs[todo[k]])
         if level > 0:
             # memory bound: an angle whose next level needs more than MAX_ANGLE_NODES keeps
             # the previous level's estimate and its (larger, honest) error estimate
             fits = counts <= MAX_ANGLE_NODES
+            status[todo[~fits]] = NODE_CAP
             todo, counts, npieces = todo[fits], counts[fits], npieces[fits]
             if todo.size == 0:
                 break
@@ -604,15 +643,20 @@ def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool,
                 acc += int(counts[stop])
                 stop += 1
             idx = todo[start:stop]
-            bad = _integrate_chunk(evaluate, thetas[idx], mode, width, level, sym, nvnl, kvs[idx],
-                                   counts[start:stop], npieces[start:stop], a, e, idx, tol)
-            levels[idx] = level
-            still.append(idx[bad])
+            above = _integrate_chunk(evaluate, thetas[idx], mode, width, level, sym, kinks,
+                                     kvs[idx], counts[start:stop], npieces[start:stop], a, e,
+                                     bad, idx, tol)
+            still.append(idx[above])
             start = stop
         todo = np.concatenate(still) if still else todo[:0]
         if todo.size == 0:
             break
-    return a, e, levels
+    status[todo] = MAX_LEVEL_REACHED  # still above the goal after the last level
+    nonfinite = bad > 0
+    status[nonfinite] = NONFINITE
+    a[nonfinite] = np.nan
+    e[nonfinite] = np.inf
+    return a, e, status
 
 
 # --------------------------------------------------------------------------- public API
@@ -628,52 +672,85 @@ class AlbedoResult:
         a(θ_i), shape ``theta.shape`` or ``theta.shape + (C,)`` for coloured models.
     error : ndarray
         Error estimate (absolute), same shape as ``albedo``.
+    status : ndarray of int8, shape ``theta.shape``
+        Per angle: :data:`CONVERGED` (0), :data:`MAX_LEVEL_REACHED` (1),
+        :data:`NODE_CAP` (2) or :data:`NONFINITE` (3); :data:`STATUS_MESSAGES`
+        says what each means. Only CONVERGED angles meet the tolerance.
     """
 
     theta: np.ndarray
     albedo: np.ndarray
     error: np.ndarray
+    status: np.ndarray | None = None
+
+    def __post_init__(self):
+        st = (np.zeros(np.shape(self.theta), dtype=np.int8) if self.status is None
+              else np.asarray(self.status, dtype=np.int8).reshape(np.shape(self.theta)))
+        object.__setattr__(self, "status", st)
+
+    @property
+    def success(self) -> bool:
+        """True when every angle converged to the tolerance."""
+        return bool(np.all(self.status == CONVERGED))
+
+    @property
+    def message(self) -> str:
+        """One line: converged, or which angles did not and why."""
+        if self.success:
+            return STATUS_MESSAGES[CONVERGED]
+        th = np.degrees(np.asarray(self.theta)).reshape(-1)
+        st = self.status.reshape(-1)
+        parts = []
+        for code in (MAX_LEVEL_REACHED, NODE_CAP, NONFINITE):
+            where = th[st == code]
+            if where.size:
+                shown = ", ".join(f"{x:g}" for x in where[:5]) + (" ..." if where.size > 5
+                                                                  else "")
+                parts.append(f"theta_i = {shown} deg: {STATUS_MESSAGES[code]}")
+        return "; ".join(parts)
 
     def to_dict(self) -> dict:
-        """JSON-ready: θ in degrees, albedo and error (per-channel lists when coloured)."""
-        return {"theta_deg": np.degrees(self.theta).tolist(),
-                "albedo": np.asarray(self.albedo).tolist(),
-                "error": np.asarray(self.error).tolist()}
+        """JSON-ready: θ in degrees, albedo and error (per-channel lists when coloured), and,
+        when some angle did not converge, its ``status`` codes and ``message``."""
+        d = {"theta_deg": np.degrees(self.theta).tolist(),
+             "albedo": np.asarray(self.albedo).tolist(),
+             "error": np.asarray(self.error).tolist()}
+        if not self.success:
+            d["status"] = self.status.tolist()
+            d["message"] = self.message
+        return d
 
 
 def lobe_frame(model) -> tuple[int, float]:
-    """(mode, width) of the integration frame: the frame of the sharpest lobe."""
-    lobes = model.lobes() if hasattr(model, "lobes") else []
-    if not lobes:
+    """(mode, width) of the integration frame: the model's :meth:`~BRDF.sharpest_lobe`
+    (normal frame, width π/2 for a plain callable)."""
+    if not isinstance(model, BRDF):
         return NORMAL, math.pi / 2
-    best = min(lobes, key=lambda lb: lb.width)
-    kinds = {lb.kind for lb in lobes}
-    mode = _MODE.get(best.kind, NORMAL)
-    width = float(best.width)
-    if not math.isfinite(width) or width <= 0.0:
-        width = math.pi / 2
-    if mode == NORMAL and ("mirror" in kinds or "half" in kinds):
-        mode = _MODE[next(lb.kind for lb in lobes if lb.kind in ("mirror", "half"))]
-    return mode, min(width, math.pi / 2)
+    lobe = model.sharpest_lobe()
+    return _MODE.get(lobe.kind, NORMAL), float(lobe.width)
 
 
-#: Registered models whose formula has a max(N·L, N·V) (Neumann et al. eq. 22): their
-#: kink N·V = N·L is a break point from the start. Other models can declare
-#: ``albedo_kinks = ("nv=nl",)``; any model gets it from the first refinement on.
-NVNL_KINK_MODELS = frozenset({"neumann-phong"})
-
-
-def _has_nvnl_kink(model) -> bool:
-    return getattr(model, "name", None) in NVNL_KINK_MODELS or \
-        "nv=nl" in tuple(getattr(model, "albedo_kinks", ()))
+def _kink_flags(model) -> int:
+    """The node generators' bit flags for the model's declared :attr:`albedo_kinks`."""
+    if not isinstance(model, BRDF):
+        return 0
+    unknown = set(model.albedo_kinks) - set(_KINK_BITS)
+    if unknown:
+        raise BrdfkitError(f"{model.name}: albedo_kinks {sorted(unknown)} are not known to the "
+                           f"albedo engine; known: {', '.join(_KINK_BITS)}")
+    flags = 0
+    for k in model.albedo_kinks:
+        flags |= _KINK_BITS[k]
+    return flags
 
 
 MAX_KINKS = 12
 
 
-def _declared_kinks(model, flat: np.ndarray) -> np.ndarray | None:
-    """The model's ``albedo_kinks_nv(theta) -> (T, K)`` levels k of N·V where its
-    integrand has a kink (NaN: none), or None."""
+def _declared_levels(model, flat: np.ndarray) -> np.ndarray | None:
+    """The model's :meth:`~BRDF.albedo_kinks_nv` levels, shape (T, K ≤ MAX_KINKS), or None."""
+    if not isinstance(model, BRDF):
+        return None
     kv = model.albedo_kinks_nv(flat)
     if kv is None:
         return None
@@ -684,14 +761,19 @@ def _declared_kinks(model, flat: np.ndarray) -> np.ndarray | None:
     return np.ascontiguousarray(kv)
 
 
-def _check_theta(theta_i) -> np.ndarray:
-    th = np.asarray(theta_i, dtype=np.float64)
+def check_theta(theta_i, name: str = "theta_i") -> np.ndarray:
+    """*theta_i* as float64 radians in [0, π/2); :class:`ParameterError` naming *name*."""
+    try:
+        th = np.asarray(theta_i, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be a number or an array of numbers (radians in "
+                             f"[0, pi/2)); got {theta_i!r}") from None
     if not np.all(np.isfinite(th)):
-        raise ParameterError("theta_i must be finite (radians)")
+        raise ParameterError(f"{name} must be finite (radians)")
     if np.any((th < 0.0) | (th >= math.pi / 2)):
         bad = th[(th < 0.0) | (th >= math.pi / 2)].flat[0]
         raise ParameterError(
-            f"theta_i must lie in [0, pi/2) radians = [0, 90) degrees; got {bad!r} rad")
+            f"{name} must lie in [0, pi/2) radians = [0, 90) degrees; got {bad!r} rad")
     return th
 
 
@@ -705,9 +787,12 @@ def _check_tol(tol: float) -> float:
     return t
 
 
-def _is_compiled(model) -> bool:
-    kernel = getattr(model, "kernel", None)
-    return hasattr(model, "packed") and hasattr(kernel, "py_func")  # a Numba dispatcher
+def _check_model(model, func: str) -> None:
+    if isinstance(model, BRDF) or (callable(model) and not isinstance(model, type)):
+        return
+    hint = (f" (build it first: brdfkit.model({model!r}))" if isinstance(model, str) else "")
+    raise BrdfkitError(f"{func}: model must be a brdfkit model (BRDF) or a callable "
+                       f"f(wi, wo); got {type(model).__name__} {model!r}{hint}")
 
 
 def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
@@ -718,47 +803,51 @@ def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
     ----------
     model : BRDF or callable
         A brdfkit model (integrated through its compiled kernel, in the frame
-        of its sharpest lobe) or any callable ``f(wi, wo) -> array`` taking
-        broadcastable (..., 3) arrays and returning (...) or (..., C).
-        ω_i lies in the xz-plane at azimuth 0.
+        of its sharpest lobe, with the kinks it declares) or any callable
+        ``f(wi, wo) -> array`` taking broadcastable (..., 3) arrays and
+        returning (...) or (..., C). ω_i lies in the xz-plane at azimuth 0.
     theta_i : float or array_like
         Incidence angles in radians, in [0, π/2).
     tol : float, keyword-only
         Absolute accuracy goal (default 1e-7). Panels are halved until the
         error estimate meets it (or a relative 1e-10), at most 5 times.
     mode : {"diffuse", "mirror", "half"}, optional
-        Override the integration frame (default: from ``model.lobes()``;
-        ``diffuse`` for callables without ``lobes``).
+        Override the integration frame (default: from
+        :meth:`~brdfkit.models.BRDF.sharpest_lobe`; ``diffuse`` for callables).
     width : float, optional
         Override the lobe width (radians) that grades the panels.
 
     Returns
     -------
     AlbedoResult
-        ``theta``, ``albedo`` and ``error`` (absolute error estimate).
-        Models with a ``specular_albedo(theta)`` method (a delta term not in
-        the kernel, e.g. He–Torrance) have it added, with no extra error.
+        ``theta``, ``albedo``, ``error`` (absolute error estimate) and
+        ``status`` per angle (``success`` when all converged; an angle that
+        did not keeps its last estimate and says why; an integrand that is NaN
+        or infinite at a node gives albedo NaN with status NONFINITE — it is
+        never silently replaced). A model with a delta term (``has_delta``,
+        e.g. He–Torrance) has its :meth:`~brdfkit.models.BRDF.specular_albedo`
+        added, with no extra error.
 
     Notes
     -----
-    A model can declare kinks of its integrand on curves N·V = k (constant
-    θ_o, e.g. N·V = N·L for max(N·L, N·V) terms, or the levels where a pumped
-    model's g switches branch) with a method ``albedo_kinks_nv(theta) -> (T, K)``
-    giving for each θ_i up to 12 levels k (NaN for none); they become panel
-    edges in every frame (closed forms in :func:`_phi_breaks`), so the error
-    estimate stays honest. At most 6e6 nodes are used per angle
-    (``MAX_ANGLE_NODES``): an angle needing more keeps the last level's result
-    and its (larger) error estimate.
+    The model protocol (:class:`~brdfkit.models.BRDF`) is all the engine reads:
+    ``isotropic`` (integrate half the azimuths and double), ``albedo_kinks``
+    (``"nv=nl"``, ``"vgroove"``: closed-form curves made panel edges),
+    ``albedo_kinks_nv(theta)`` (up to 12 levels k of circles N·V = k per angle,
+    e.g. where a pumped model's g switches branch; edges in every frame, closed
+    forms in :func:`_phi_breaks`), ``specular_albedo``. At most 6e6 nodes are
+    used per angle (``MAX_ANGLE_NODES``).
 
     Examples
     --------
     >>> import brdfkit, numpy as np
     >>> from brdfkit.analysis import albedo
     >>> r = albedo(brdfkit.model("lambert", rho_d=0.5), np.radians([0, 60, 89]))
-    >>> np.allclose(r.albedo, 0.5)
-    True
+    >>> np.allclose(r.albedo, 0.5), r.success
+    (True, True)
     """
-    th = _check_theta(theta_i)
+    _check_model(model, "albedo")
+    th = check_theta(theta_i)
     tol = _check_tol(tol)
     m_mode, m_width = lobe_frame(model)
     if mode is not None:
@@ -766,43 +855,49 @@ def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
             raise ParameterError(f"mode must be one of {', '.join(_MODE)}; got {mode!r}")
         m_mode = _MODE[mode]
     if width is not None:
-        if not (float(width) > 0.0):
-            raise ParameterError(f"width must be > 0 radians; got {width!r}")
-        m_width = float(width)
+        try:
+            w = float(width)
+        except (TypeError, ValueError):
+            w = float("nan")
+        if not (w > 0.0 and math.isfinite(w)):
+            raise ParameterError(f"width must be a finite number > 0 (radians); got {width!r}")
+        m_width = w
     flat = np.ascontiguousarray(th.reshape(-1))
-    if _is_compiled(model):
-        P = np.ascontiguousarray(np.asarray(model.packed, dtype=np.float64))
-        sym = bool(getattr(model, "isotropic", True))
-        kernel = model.kernel
+    if isinstance(model, BRDF):
+        if model.kernel is not None:
+            P = np.ascontiguousarray(np.asarray(model.packed, dtype=np.float64))
+            kernel = model.kernel
 
-        def evaluate(th, offsets, wo):
-            vals = np.empty((wo.shape[0], P.shape[0]))
-            _eval_kernel(kernel, P, th, offsets, wo, vals)
-            return vals
+            def evaluate(th, offsets, wo):
+                vals = np.empty((wo.shape[0], P.shape[0]))
+                bad = np.zeros(th.size, dtype=np.int64)
+                _eval_kernel(kernel, P, th, offsets, wo, vals, bad)
+                return vals, bad
 
-        a, e, _ = _integrate(evaluate, flat, m_mode, m_width, sym, tol, P.shape[0],
-                             _has_nvnl_kink(model),
-                             _declared_kinks(model, flat) if isinstance(model, BRDF) else None)
-        coloured = getattr(model, "n_channels", None) is not None
-    elif callable(model):
-        a, e, coloured = _albedo_callable(model, flat, m_mode, m_width, tol)
+            n_channels = P.shape[0]
+        else:
+            evaluate, n_channels = _callable_evaluator(model.eval, "albedo: model.eval")
+        a, e, status = _integrate(evaluate, flat, m_mode, m_width, model.isotropic, tol,
+                                  n_channels, _kink_flags(model), _declared_levels(model, flat))
+        coloured = model.n_channels is not None
+        extra = model.specular_albedo(flat)
+        if extra is not None:
+            a = a + np.asarray(extra, dtype=np.float64).reshape(flat.size, -1)
     else:
-        raise BrdfkitError(f"albedo: model must be a BRDF or a callable f(wi, wo); got "
-                           f"{type(model).__name__}")
-    extra = model.specular_albedo(flat) if isinstance(model, BRDF) else None
-    if extra is not None:
-        a = a + np.asarray(extra, dtype=np.float64).reshape(flat.size, -1)
+        evaluate, n_channels = _callable_evaluator(model, "albedo: the callable")
+        a, e, status = _integrate(evaluate, flat, m_mode, m_width, False, tol, n_channels)
+        coloured = evaluate.coloured
     if coloured:
         shape = th.shape + (a.shape[1],)
     else:
         a, e = a[:, 0], e[:, 0]
         shape = th.shape
-    return AlbedoResult(theta=th.copy(), albedo=a.reshape(shape), error=e.reshape(shape))
+    return AlbedoResult(theta=th.copy(), albedo=a.reshape(shape), error=e.reshape(shape),
+                        status=status.reshape(th.shape))
 
 
-def _albedo_callable(f: Callable, flat: np.ndarray, mode: int, width: float, tol: float):
-    """Same rule as the compiled path; nodes built in Numba, f evaluated vectorised."""
-    shape_info = {}
+def _callable_evaluator(f: Callable, what: str):
+    """(evaluate, n_channels) for a NumPy-evaluated f: nodes built in Numba, f vectorised."""
 
     def evaluate(th, offsets, wo):
         idx = np.repeat(np.arange(th.size), np.diff(offsets))
@@ -810,20 +905,35 @@ def _albedo_callable(f: Callable, flat: np.ndarray, mode: int, width: float, tol
         wi = np.stack([np.sin(th[idx]), np.zeros(idx.size), np.cos(th[idx])], axis=-1)[up]
         got = np.asarray(f(wi, np.ascontiguousarray(wo[up])), dtype=np.float64)
         if got.shape[:1] != (wi.shape[0],) or got.ndim > 2:
-            raise BrdfkitError(f"albedo: the callable returned shape {got.shape} for "
+            raise BrdfkitError(f"{what} returned shape {got.shape} for "
                                f"{wi.shape[0]} direction pairs; expected (N,) or (N, C)")
-        shape_info["coloured"] = got.ndim == 2
-        got = np.where(np.isfinite(got), got, 0.0).reshape(wi.shape[0], -1)
+        evaluate.coloured = got.ndim == 2
+        got = got.reshape(wi.shape[0], -1)
+        finite = np.isfinite(got)
+        # non-finite values are counted per angle (the angle's albedo becomes NaN) and
+        # stored as 0 so that they cannot poison the other angles' sums
+        bad = np.bincount(idx[up], weights=np.sum(~finite, axis=1),
+                          minlength=th.size).astype(np.int64)
         vals = np.zeros((wo.shape[0], got.shape[1]))
-        vals[up] = got
-        return vals
+        vals[up] = np.where(finite, got, 0.0)
+        return vals, bad
 
-    probe = evaluate(np.array([0.0]), np.array([0, 1]), np.array([[0.0, 0.0, 1.0]]))
-    a, e, _ = _integrate(evaluate, flat, mode, width, False, tol, probe.shape[1])
-    return a, e, shape_info["coloured"]
+    evaluate.coloured = False
+    probe, _ = evaluate(np.array([0.0]), np.array([0, 1]), np.array([[0.0, 0.0, 1.0]]))
+    return evaluate, probe.shape[1]
 
 
 # --------------------------------------------------------------------------- Monte Carlo
+def _check_rng(rng) -> np.random.Generator:
+    if isinstance(rng, np.random.Generator):
+        return rng
+    if rng is None or (isinstance(rng, int | np.integer) and not isinstance(rng, bool)
+                       and rng >= 0):
+        return np.random.default_rng(rng)
+    raise ParameterError(f"rng must be a seed (an integer >= 0), a numpy.random.Generator "
+                         f"or None; got {type(rng).__name__} {rng!r}")
+
+
 def albedo_mc(model, theta_i, *, n_samples: int = 100_000, rng=None,
               defensive: float = 0.1) -> AlbedoResult:
     """Importance-sampled Monte-Carlo albedo with its standard error.
@@ -839,7 +949,7 @@ def albedo_mc(model, theta_i, *, n_samples: int = 100_000, rng=None,
     theta_i : float or array_like
         Radians in [0, π/2).
     n_samples : int, keyword-only
-        Samples per angle.
+        Samples per angle (≥ 2).
     rng : int or numpy.random.Generator, keyword-only
         Seed or generator (required for reproducibility; None draws fresh entropy).
     defensive : float, keyword-only
@@ -848,21 +958,28 @@ def albedo_mc(model, theta_i, *, n_samples: int = 100_000, rng=None,
     Returns
     -------
     AlbedoResult
-        ``error`` is the standard error of the mean (1σ).
+        ``error`` is the standard error of the mean (1σ); status NONFINITE
+        (albedo NaN) where a sample's value was NaN or infinite.
     """
     from brdfkit.geometry import pdf_cosine_hemisphere, sample_cosine_hemisphere
 
-    th = _check_theta(theta_i)
+    _check_model(model, "albedo_mc")
+    th = check_theta(theta_i)
+    if isinstance(n_samples, bool) or not isinstance(n_samples, int | np.integer) \
+            or n_samples < 2:
+        raise ParameterError(f"n_samples must be an integer >= 2; got {n_samples!r}")
     n_samples = int(n_samples)
-    if n_samples < 2:
-        raise ParameterError(f"n_samples must be >= 2; got {n_samples}")
+    try:
+        defensive = float(defensive)
+    except (TypeError, ValueError):
+        defensive = float("nan")
     if not (0.0 < defensive <= 1.0):
         raise ParameterError(f"defensive must lie in (0, 1]; got {defensive!r}")
-    gen = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
-    has_sampler = bool(getattr(model, "has_sampler", False)) and hasattr(model, "sample")
+    gen = _check_rng(rng)
+    has_sampler = isinstance(model, BRDF) and model.has_sampler
     if not has_sampler:
         defensive = 1.0
-    vals_a, vals_e = [], []
+    vals_a, vals_e, status = [], [], []
     for theta in th.reshape(-1):
         wi = np.array([math.sin(theta), 0.0, math.cos(theta)])
         u = gen.random((n_samples, 2))
@@ -879,16 +996,23 @@ def albedo_mc(model, theta_i, *, n_samples: int = 100_000, rng=None,
         w_safe = np.where(up[:, None], w, np.array([0.0, 0.0, 1.0]))
         f = evaluate_pairs(model, wib, w_safe)
         est = np.where(up[:, None], f * (w_safe[:, 2] / np.where(up, pdf, 1.0))[:, None], 0.0)
-        vals_a.append(est.mean(axis=0))
-        vals_e.append(est.std(axis=0, ddof=1) / math.sqrt(n_samples))
+        ok = bool(np.all(np.isfinite(est)))
+        vals_a.append(est.mean(axis=0) if ok else np.full(est.shape[1], np.nan))
+        vals_e.append(est.std(axis=0, ddof=1) / math.sqrt(n_samples) if ok
+                      else np.full(est.shape[1], np.inf))
+        status.append(CONVERGED if ok else NONFINITE)
     a = np.array(vals_a)
     e = np.array(vals_e)
     extra = model.specular_albedo(th.reshape(-1)) if isinstance(model, BRDF) else None
     if extra is not None:
         a = a + np.asarray(extra, dtype=np.float64).reshape(a.shape[0], -1)
-    if getattr(model, "n_channels", None) is None and a.shape[1] == 1:
-        return AlbedoResult(th.copy(), a[:, 0].reshape(th.shape), e[:, 0].reshape(th.shape))
-    return AlbedoResult(th.copy(), a.reshape(th.shape + (-1,)), e.reshape(th.shape + (-1,)))
+    status = np.array(status, dtype=np.int8).reshape(th.shape)
+    coloured = model.n_channels is not None if isinstance(model, BRDF) else a.shape[1] > 1
+    if not coloured and a.shape[1] == 1:
+        return AlbedoResult(th.copy(), a[:, 0].reshape(th.shape), e[:, 0].reshape(th.shape),
+                            status)
+    return AlbedoResult(th.copy(), a.reshape(th.shape + (-1,)), e.reshape(th.shape + (-1,)),
+                        status)
 
 
 # --------------------------------------------------------------------------- ρ_hh and H_s
@@ -902,8 +1026,15 @@ def hemispherical_albedo(model, *, n: int = 48, tol: float = 1e-7) -> tuple[np.n
 
     Returns
     -------
-    (value, error) : ndarrays, scalars or (C,) for coloured models.
+    (value, error) : ndarrays, scalars or (C,) for coloured models. The error is
+        infinite when an albedo did not converge (see :attr:`AlbedoResult.status`).
     """
+    _check_model(model, "hemispherical_albedo")
+    if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 2 <= n <= 1000:
+        # the n/2-point rule gives the error estimate, so n >= 2; 1000 nodes: far beyond the
+        # accuracy of the albedo itself (a is smooth in u = sqrt(cos theta_i))
+        raise ParameterError(f"hemispherical_albedo: n must be an integer in [2, 1000]; "
+                             f"got {n!r}")
     x, w = np.polynomial.legendre.leggauss(int(n))
     x2, w2 = np.polynomial.legendre.leggauss(int(n) // 2)
     us = np.concatenate([(x + 1) / 2, (x2 + 1) / 2])
@@ -917,7 +1048,10 @@ def hemispherical_albedo(model, *, n: int = 48, tol: float = 1e-7) -> tuple[np.n
     v1 = np.tensordot(w / 2, aw[: len(x)], axes=(0, 0))
     v2 = np.tensordot(w2 / 2, aw[len(x):], axes=(0, 0))
     ew = np.asarray(r.error)[: len(x)] * wt[: len(x)]
-    return v1, np.abs(v1 - v2) + np.tensordot(w / 2, ew, axes=(0, 0))
+    err = np.abs(v1 - v2) + np.tensordot(w / 2, ew, axes=(0, 0))
+    if not r.success:  # an unconverged angle's estimate is not a bound
+        err = np.full_like(err, np.inf)
+    return v1, err
 
 
 @numba.njit(cache=True)

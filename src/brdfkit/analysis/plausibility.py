@@ -18,6 +18,9 @@ whether it conserves energy (Lewis §4–5, Neumann §2):
   asymptotics, not one value. Otherwise *conserves* if max a ≤ 1 (+1e-6
   numerical slack) or *exceeds*, with ``max_scale`` = 1/max a, the largest
   factor on the model's reflectance that makes it conserve (Lewis §4.2's b_j).
+  *undetermined*: the albedo could not be computed (NaN), or did not converge
+  to the tolerance and its maximum is within its error estimate of 1 — no
+  verdict is claimed that the accuracy cannot support; the notes say why.
 - **Other objections** detected numerically: radiance that always peaks at
   the normal (Lewis §3.3–3.4 against Neumann–Neumann and Minnaert), albedo
   that collapses at grazing incidence (Neumann §1.2, the "dark Phong mirror").
@@ -43,6 +46,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from brdfkit.analysis.albedo import albedo, evaluate_pairs
+from brdfkit.errors import BrdfkitError
+from brdfkit.models._base import BRDF
 
 __all__ = ["Verdict", "check", "divergence_rate", "GRAZING_DEG", "RECIPROCITY_TOL"]
 
@@ -160,7 +165,7 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
     Parameters
     ----------
     model : BRDF
-        A brdfkit model (or any object with ``eval``/``__call__``, ``lobes``).
+        A brdfkit model (registered, pumped or otherwise derived).
     tol : float, keyword-only
         Albedo accuracy goal.
 
@@ -168,14 +173,26 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
     -------
     Verdict
     """
-    d = model.to_dict() if hasattr(model, "to_dict") else {"model": type(model).__name__,
-                                                           "params": {}}
+    if not isinstance(model, BRDF):
+        hint = (f" (build it first: brdfkit.model({model!r}))" if isinstance(model, str) else "")
+        raise BrdfkitError(f"check: model must be a brdfkit model (BRDF); got "
+                           f"{type(model).__name__} {model!r}{hint}")
+    d = model.to_dict()
     asym = reciprocity(model)
     grid = np.concatenate([np.arange(0.0, 87.01, 3.0), [89.0, 89.5], GRAZING_DEG[1:]])
     r = albedo(model, np.radians(grid), tol=tol)
     a = np.asarray(r.albedo).reshape(grid.size, -1)
     err = float(np.max(np.asarray(r.error)))
     notes: list[str] = []
+    if not r.success:
+        notes.append(f"albedo not computed to the tolerance {tol:g}: {r.message}")
+    if not np.all(np.isfinite(a)):
+        # no verdict on energy from values that do not exist
+        return Verdict(
+            model=d["model"], params=d["params"], reciprocal=bool(asym <= RECIPROCITY_TOL),
+            max_asymmetry=asym, energy="undetermined", max_albedo=float("nan"),
+            theta_max_deg=float("nan"), divergence_exponent=None, max_scale=None, notes=notes,
+            albedo_error=float("inf"), pump=d.get("pump"))
 
     # --- divergence from the asymptotics, per channel
     ig = [int(np.argmin(np.abs(grid - g))) for g in GRAZING_DEG]
@@ -218,7 +235,16 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
             f"{max_a:.4g}")
     else:
         p_rounded = None
-        if max_a <= 1.0 + max(CONSERVE_SLACK, 10 * err):
+        # the error estimate where it matters: at the maximum (converged or not)
+        err_max = float(np.max(np.asarray(r.error).reshape(grid.size, -1)[k])) \
+            if theta_max == float(grid[k]) else err
+        if not r.success and abs(max_a - 1.0) <= max(CONSERVE_SLACK, 10 * err_max):
+            # the albedo is within its (unconverged) error of 1: no claim either way
+            energy = "undetermined"
+            max_scale = None
+            notes.append(f"energy undetermined: max albedo {max_a:.6g} at {theta_max:g} deg "
+                         f"is within its error estimate {err_max:.2g} of 1")
+        elif max_a <= 1.0 + max(CONSERVE_SLACK, 10 * err):
             energy = "conserves"
             max_scale = None
         else:
