@@ -668,12 +668,16 @@ class DerivedBRDF(BRDF):
         The parameter a half-angle ``beta`` converts to.
     kernel : compiled kernel or None
         None: the subclass overrides :meth:`eval`.
+    packed : array_like (C, K), optional
+        The kernel's packed rows when they are not those of :meth:`BRDF._pack`
+        for *params* (e.g. wrapping another model's kernel: ``other.packed``).
     """
 
     def __init__(self, *, name: str, params, values: dict, citation: str = "",
                  summary: str = "", reciprocal: bool, has_sampler: bool = False,
                  isotropic: bool = True, has_delta: bool = False,
-                 width_param: str | None = None, kernel: Callable | None = None):
+                 width_param: str | None = None, kernel: Callable | None = None,
+                 packed=None):
         self.name = str(name)
         self.params = tuple(params)
         self.citation = citation
@@ -684,7 +688,14 @@ class DerivedBRDF(BRDF):
         self.has_delta = bool(has_delta)
         self.width_param = width_param
         self.kernel = kernel
+        self._given_packed = (None if packed is None else np.ascontiguousarray(
+            np.array(packed, dtype=np.float64, ndmin=2)))
         self._setup(dict(values))
+
+    def _pack(self) -> np.ndarray:
+        if self._given_packed is not None:
+            return self._given_packed
+        return super()._pack()
 
     def describe(self) -> dict:  # an instance method here: the declarations are per instance
         """JSON-ready description of this model (as :meth:`BRDF.describe`)."""
