@@ -1,0 +1,109 @@
+"""The layering of docs/architecture.md, enforced on the source.
+
+- A module imports only from its own layer and the layers below (imports inside
+  functions count too).
+- No brdfkit module is imported inside ``try/except ImportError`` (self-guarding).
+- No source file over ~800 lines (issue 8; 850 allows the "~").
+- No engine probes a model with getattr/hasattr for a protocol hook.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+SRC = Path(__file__).resolve().parents[1] / "src" / "brdfkit"
+
+#: docs/architecture.md, "Layers"
+LAYER = {
+    "errors": 0, "_array": 0, "_kern": 0, "geometry": 0, "fresnel": 0, "halfangle": 0,
+    "tables": 0,
+    "": 1, "models": 1,
+    "analysis": 2, "data": 2,
+    "pumping": 3, "fitting": 3, "render": 3,
+    "figures": 4, "cli": 4, "report": 4, "explorer": 4, "__main__": 4,
+}
+MAX_LINES = 850
+#: hooks of the model protocol that must be read as declared attributes, never probed
+HOOKS = {"isotropic", "specular_albedo", "albedo_kinks", "albedo_kinks_nv", "albedo_kink_mus",
+         "has_delta", "has_sampler", "lobes", "sharpest_lobe", "kernel", "packed", "n_channels",
+         "reciprocal", "sample", "pdf", "to_dict"}
+
+
+def _modules():
+    return sorted(p for p in SRC.rglob("*.py"))
+
+
+def _top(path: Path) -> str:
+    rel = path.relative_to(SRC).with_suffix("")
+    parts = rel.parts
+    if parts == ("__init__",):
+        return ""
+    return parts[0]
+
+
+def _imported_tops(tree: ast.AST):
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for a in node.names:
+                if a.name == "brdfkit" or a.name.startswith("brdfkit."):
+                    yield node, (a.name.split(".") + [""])[1]
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            if node.module == "brdfkit":
+                # `from brdfkit import x`: x is a subpackage/module or a root re-export
+                for a in node.names:
+                    yield node, a.name if a.name in LAYER else ""
+            elif node.module.startswith("brdfkit."):
+                yield node, node.module.split(".")[1]
+
+
+@pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(SRC)))
+def test_imports_go_down_only(path):
+    top = _top(path)
+    assert top in LAYER, f"{path}: module {top!r} is in no layer of docs/architecture.md"
+    tree = ast.parse(path.read_text())
+    for node, other in _imported_tops(tree):
+        assert other in LAYER, f"{path}:{node.lineno}: imports unknown brdfkit.{other}"
+        assert LAYER[other] <= LAYER[top], (
+            f"{path}:{node.lineno}: layer {LAYER[top]} ({top or 'brdfkit'}) imports "
+            f"brdfkit.{other} of layer {LAYER[other]} (docs/architecture.md)")
+
+
+@pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(SRC)))
+def test_no_self_guarding_imports(path):
+    tree = ast.parse(path.read_text())
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Try):
+            continue
+        catches_import_error = any(
+            h.type is not None and "ImportError" in ast.unparse(h.type) for h in node.handlers)
+        if not catches_import_error:
+            continue
+        for inner in node.body:
+            for sub in ast.walk(inner):
+                if isinstance(sub, ast.Import | ast.ImportFrom):
+                    names = ([a.name for a in sub.names] if isinstance(sub, ast.Import)
+                             else [sub.module or ""])
+                    assert not any(n.startswith("brdfkit") for n in names), (
+                        f"{path}:{sub.lineno}: brdfkit module imported inside "
+                        "try/except ImportError")
+
+
+@pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(SRC)))
+def test_source_files_are_not_too_long(path):
+    n = len(path.read_text().splitlines())
+    assert n <= MAX_LINES, f"{path} has {n} lines (> {MAX_LINES}): split it"
+
+
+@pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(SRC)))
+def test_protocol_hooks_are_not_probed(path):
+    tree = ast.parse(path.read_text())
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                and node.func.id in ("getattr", "hasattr") and len(node.args) >= 2
+                and isinstance(node.args[1], ast.Constant)):
+            assert node.args[1].value not in HOOKS, (
+                f"{path}:{node.lineno}: {node.func.id}(..., {node.args[1].value!r}) probes a "
+                "declared protocol hook; read the attribute (models.BRDF declares it)")
