@@ -1,0 +1,258 @@
+"""The MERL .binary format: exact I/O, the reference reader's lookup, MeasuredBRDF.
+
+References used here (independent of the code under test):
+- the file layout and the lookup formulas of MERL's BRDFRead.cpp as stated in issue 9
+  (re-implemented below in NumPy from those formulas, not from brdfkit's code);
+- RED/GREEN/BLUE_SCALE = 1/1500, 1.15/1500, 1.66/1500 (BRDFRead.cpp);
+- closed forms: a bin centre maps back to itself (u = i + 1/2 in index coordinates).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+
+import numpy as np
+import pytest
+
+import brdfkit
+from brdfkit.data.merl import (
+    N_BINS,
+    SHAPE,
+    MeasuredBRDF,
+    MerlTable,
+    bin_centres,
+    half_diff_to_directions,
+    merl_indices,
+    read_binary,
+    table_from_function,
+    write_binary,
+)
+from brdfkit.errors import BrdfkitError, DataFileError
+
+FILE_BYTES = 12 + 3 * 90 * 90 * 180 * 8
+
+
+# ----------------------------------------------------------------- independent reference
+def _rotate(v, axis, angle):
+    """Rodrigues' rotation, as BRDFRead.cpp's rotate_vector."""
+    c, s = np.cos(angle)[..., None], np.sin(angle)[..., None]
+    cross = np.cross(axis, v)
+    return v * c + axis * np.sum(axis * v, axis=-1, keepdims=True) * (1 - c) + cross * s
+
+
+def reference_index(wi, wo):
+    """BRDFRead.cpp: std_coords_to_half_diff_coords + the three *_index functions."""
+    h = wi + wo
+    h = h / np.linalg.norm(h, axis=-1, keepdims=True)
+    theta_h = np.arccos(np.clip(h[..., 2], -1, 1))
+    phi_h = np.arctan2(h[..., 1], h[..., 0])
+    tmp = _rotate(wi, np.array([0.0, 0.0, 1.0]), -phi_h)
+    d = _rotate(tmp, np.array([0.0, 1.0, 0.0]), -theta_h)
+    theta_d = np.arccos(np.clip(d[..., 2], -1, 1))
+    phi_d = np.arctan2(d[..., 1], d[..., 0])
+    ih = np.where(theta_h <= 0, 0, np.sqrt(theta_h / (np.pi / 2) * 90 * 90).astype(np.int64))
+    ih = np.clip(ih, 0, 89)
+    idd = np.clip((theta_d / (np.pi / 2) * 90).astype(np.int64), 0, 89)
+    pd = np.where(phi_d < 0, phi_d + np.pi, phi_d)
+    ip = np.clip((pd / np.pi * 180).astype(np.int64), 0, 179)
+    return ip + 180 * idd + 180 * 90 * ih
+
+
+def _random_pairs(rng, n):
+    def hemi(n):
+        z = 1.0 - rng.random(n)
+        phi = 2 * np.pi * rng.random(n)
+        r = np.sqrt(1 - z * z)
+        return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
+    return hemi(n), hemi(n)
+
+
+@pytest.fixture(scope="module")
+def raw_table():
+    # a table of our own making: smooth positive values with a few unmeasured (-1) bins
+    rng = np.random.default_rng(7)
+    raw = rng.random((3, *SHAPE)) * 100.0 + 1.0
+    raw[:, 5, 80:, :] = -1.0  # unmeasured, as MERL's grazing theta_d bins
+    return raw
+
+
+@pytest.fixture(scope="module")
+def merl_file(tmp_path_factory, raw_table):
+    path = tmp_path_factory.mktemp("merl") / "own.binary"
+    with open(path, "wb") as fh:  # written here byte by byte from the layout, not by brdfkit
+        np.array([90, 90, 180], dtype="<i4").tofile(fh)
+        raw_table.astype("<f8").tofile(fh)
+    return path
+
+
+# ----------------------------------------------------------------- I/O
+def test_read_matches_layout_and_scales(merl_file, raw_table):
+    t = read_binary(merl_file)
+    assert t.raw.shape == (3, 90, 90, 180)
+    np.testing.assert_array_equal(t.raw, raw_table)
+    scales = np.array([1 / 1500, 1.15 / 1500, 1.66 / 1500])
+    np.testing.assert_array_equal(t.values[1, 3, 4, 5], raw_table[1, 3, 4, 5] * scales[1])
+    assert not t.valid[0, 5, 85, 3] and t.valid[0, 5, 79, 3]
+    assert t.valid_fraction == pytest.approx(1 - 10 * 180 / N_BINS)
+
+
+def test_write_read_round_trip_is_bit_exact(merl_file, tmp_path):
+    out = tmp_path / "copy.binary"
+    write_binary(out, read_binary(merl_file))
+    assert out.read_bytes() == merl_file.read_bytes()
+    # and from scaled values: read(write(values)) reproduces the values to 1 ulp
+    t = read_binary(merl_file)
+    out2 = tmp_path / "from_values.binary"
+    write_binary(out2, t.values)
+    np.testing.assert_allclose(read_binary(out2).values, t.values, rtol=2.3e-16, atol=0)
+
+
+def test_write_is_atomic_and_checks_the_path(tmp_path, merl_file):
+    t = read_binary(merl_file)
+    with pytest.raises(BrdfkitError, match="does not exist"):
+        write_binary(tmp_path / "nope" / "x.binary", t)
+    with pytest.raises(BrdfkitError, match="directory"):
+        write_binary(tmp_path, t)
+    write_binary(tmp_path / "x.binary", t)
+    assert sorted(os.listdir(tmp_path)) == ["x.binary"]  # no temporary file left
+
+
+def _write_bytes(path, data: bytes):
+    path.write_bytes(data)
+    return path
+
+
+@pytest.mark.parametrize("mutate, needle", [
+    (lambda b: b[:8], "header"),
+    (lambda b: b"", "header"),
+    (lambda b: np.array([90, 90, 360], "<i4").tobytes() + b[12:], "(90, 90, 360)"),
+    (lambda b: np.array([180, 90, 90], "<i4").tobytes() + b[12:], "(180, 90, 90)"),
+    (lambda b: b[:-8], "truncated"),
+    (lambda b: b + b"\0" * 8, "too long"),
+    (lambda b: b[:100] + np.array([np.nan]).tobytes() + b[108:], "NaN"),
+    (lambda b: b[:12] + np.full(3 * N_BINS, -1.0).tobytes(), "every entry"),
+])
+def test_malformed_files_name_file_and_field(tmp_path, merl_file, mutate, needle):
+    bad = _write_bytes(tmp_path / "bad.binary", mutate(merl_file.read_bytes()))
+    with pytest.raises(DataFileError) as exc:
+        read_binary(bad)
+    assert str(bad) in str(exc.value)
+    assert needle in str(exc.value)
+
+
+def test_not_a_file(tmp_path):
+    with pytest.raises(DataFileError, match="no such file"):
+        read_binary(tmp_path / "missing.binary")
+    with pytest.raises(DataFileError, match="not a regular file"):
+        read_binary(tmp_path)
+
+
+def test_fuzz_truncations_and_header_corruptions(tmp_path, merl_file):
+    # never crash (only DataFileError), never hang (each read well under a second)
+    rng = np.random.default_rng(11)
+    good = merl_file.read_bytes()
+    for k in range(40):
+        b = bytearray(good[: int(rng.integers(0, len(good) + 1))] if k % 2 else good)
+        if k % 3 == 0 and len(b) >= 12:
+            b[int(rng.integers(0, 12))] = int(rng.integers(0, 256))
+        p = _write_bytes(tmp_path / f"f{k}.binary", bytes(b))
+        t0 = time.perf_counter()
+        try:
+            read_binary(p)
+        except DataFileError:
+            pass
+        assert time.perf_counter() - t0 < 5.0
+
+
+# ----------------------------------------------------------------- lookup
+def test_indices_agree_with_the_reference_formulas(rng):
+    wi, wo = _random_pairs(rng, 200_000)
+    np.testing.assert_array_equal(merl_indices(wi, wo), reference_index(wi, wo))
+    # edge cases: normal incidence and exitance, the mirror pair, grazing
+    g = math.cos(math.radians(89.999))
+    edge_i = np.array([[0, 0, 1.0], [0.6, 0, 0.8], [math.sqrt(1 - g * g), 0, g], [0, 0, 1.0]])
+    edge_o = np.array([[0, 0, 1.0], [-0.6, 0, 0.8], [0, math.sqrt(1 - g * g), g], [0.6, 0, 0.8]])
+    np.testing.assert_array_equal(merl_indices(edge_i, edge_o), reference_index(edge_i, edge_o))
+
+
+def test_nearest_eval_is_the_reference_lookup(merl_file, rng):
+    t = read_binary(merl_file)
+    m = MeasuredBRDF(t)
+    wi, wo = _random_pairs(rng, 50_000)
+    idx = reference_index(wi, wo)
+    vals = t.raw.reshape(3, -1)[:, idx].T * np.array([1 / 1500, 1.15 / 1500, 1.66 / 1500])
+    got = m.eval(wi, wo)
+    assert got.shape == (50_000, 3)
+    measured = (t.raw.reshape(3, -1)[:, idx] >= 0).T
+    np.testing.assert_array_equal(got[measured], vals[measured])
+    assert np.all(np.isnan(got[~measured]))  # unmeasured: NaN, never 0 or a clamp
+    assert m.eval(wi * [1, 1, -1], wo).max() == 0.0  # below the horizon
+
+
+def test_linear_lookup_reproduces_bin_centres(merl_file):
+    # at a bin centre the trilinear weights are (1, 0, ...): the bin's own value
+    t = read_binary(merl_file)
+    m = MeasuredBRDF(t, lookup="linear")
+    th, td, pd = bin_centres()
+    ih, idd, ip = np.array([3, 20, 60, 85]), np.array([0, 10, 25, 2]), np.array([0, 17, 90, 179])
+    assert np.all(th[ih] + td[idd] < np.pi / 2)  # both directions above the horizon
+    wi, wo = half_diff_to_directions(th[ih], td[idd], pd[ip])
+    got = m.eval(wi, wo)
+    want = t.values[:, ih, idd, ip].T
+    np.testing.assert_allclose(got, want, rtol=1e-9)
+
+
+def test_linear_is_continuous_and_skips_unmeasured(merl_file):
+    t = read_binary(merl_file)
+    m = MeasuredBRDF(t, lookup="linear")
+    th, td, pd = bin_centres()
+    # theta_h bin 5 has theta_d >= 80 unmeasured: interpolation uses the measured neighbours
+    wi, wo = half_diff_to_directions(th[5], td[85], pd[30])
+    v = m.eval(wi, wo)
+    assert np.all(np.isfinite(v))
+    # halfway between two theta_d centres (measured): the mean of the two bins
+    wi, wo = half_diff_to_directions(th[40], 0.5 * (td[20] + td[21]), pd[30])
+    np.testing.assert_allclose(m.eval(wi, wo), 0.5 * (t.values[:, 40, 20, 30]
+                                                      + t.values[:, 40, 21, 30]), rtol=1e-9)
+
+
+def test_reciprocity_of_the_lookup(merl_file, rng):
+    m = MeasuredBRDF(read_binary(merl_file))
+    wi, wo = _random_pairs(rng, 20_000)
+    a, b = m.eval(wi, wo), m.eval(wo, wi)
+    ok = np.isfinite(a) & np.isfinite(b)
+    # the phi_d fold maps (wo, wi) to the same bin except within rounding of a bin boundary
+    assert np.mean(a[ok] == b[ok]) > 0.999
+
+
+def test_tabulated_model_round_trip(tmp_path):
+    # a model of our own tabulated, written, read and looked up: at bin centres the
+    # nearest lookup returns the model's value there (to the 1-ulp scale round trip)
+    model = brdfkit.model("modified-phong", rho_d=[0.1, 0.2, 0.3], rho_s=0.5, n=20)
+    t = table_from_function(model.eval, source="modified-phong")
+    write_binary(tmp_path / "phong.binary", t)
+    m = MeasuredBRDF(read_binary(tmp_path / "phong.binary"))
+    th, td, pd = bin_centres()
+    wi, wo = half_diff_to_directions(th[[2, 30, 60]], td[[5, 30, 60]], pd[[10, 90, 150]])
+    np.testing.assert_allclose(m.eval(wi, wo), model.eval(wi, wo), rtol=1e-12)
+    assert not t.valid[:, 89, 89, 0].any()  # both directions below the horizon: unmeasured
+
+
+def test_measured_model_is_a_model(merl_file):
+    from brdfkit.analysis import albedo
+
+    m = MeasuredBRDF(read_binary(merl_file), lookup="linear")
+    assert m.to_dict() == {"model": m.name, "params": {"lookup": "linear"}}
+    assert m.with_params(lookup="nearest").to_dict()["params"] == {"lookup": "nearest"}
+    with pytest.raises(BrdfkitError, match="lookup"):
+        m.with_params(lookup="cubic")
+    r = albedo(m, [0.0, 0.5])
+    assert r.albedo.shape == (2, 3)
+    assert np.all(np.isfinite(r.albedo) | (r.status[:, None] == 3))
+
+
+def test_from_values_rejects_nan():
+    with pytest.raises(BrdfkitError, match="finite"):
+        MerlTable.from_values(np.full((3, *SHAPE), np.nan))
