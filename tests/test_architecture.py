@@ -19,8 +19,10 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "brdfkit"
 #: docs/architecture.md, "Layers"
 LAYER = {
     "errors": 0, "_array": 0, "_kern": 0, "geometry": 0, "fresnel": 0, "halfangle": 0,
-    "tables": 0,
-    "": 1, "models": 1,
+    "tables": 0, "_io": 0,
+    # the package root is the public facade (brdfkit.model resolves model names and
+    # material specs): layer 2, so the data layer is below it and cli/figures above
+    "": 2, "models": 1,
     "analysis": 2, "data": 2,
     "pumping": 3, "fitting": 3, "render": 3,
     "figures": 4, "cli": 4, "report": 4, "explorer": 4, "__main__": 4,
