@@ -418,7 +418,7 @@ def test_beta_gives_half_maximum_exponent(name):
 
 @pytest.mark.parametrize("name", [n for n in PHONG_FAMILY if brdfkit.MODELS[n].has_sampler])
 def test_sampler_follows_its_pdf(name):
-    chi2 = pytest.importorskip("brdfkit.chi2")
+    chi2 = pytest.importorskip("brdfkit.analysis.chi2")
     cls = brdfkit.MODELS[name]
     for ex in cls.examples[:2]:
         m = cls(**ex)

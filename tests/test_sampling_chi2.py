@@ -1,4 +1,4 @@
-"""χ² goodness-of-fit of every model's sampler against its pdf (:mod:`brdfkit.chi2`).
+"""χ² goodness-of-fit of every model's sampler against its pdf (:mod:`brdfkit.analysis.chi2`).
 
 Every registered model × each of its ``examples`` × θ_o ∈ {0°, 30°, 60°, 80°,
 85°, 89°} (azimuth 23°, so no symmetry of the frame helps). The reference is
@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 
 import brdfkit
-from brdfkit.chi2 import SphereBinning, chi2_test, sidak_alpha
+from brdfkit.analysis.chi2 import SphereBinning, chi2_test, sidak_alpha
 from brdfkit.geometry import pdf_cosine_hemisphere, reflect, sample_cosine_hemisphere
 from brdfkit.models.phong import ModifiedPhong, pdf_phong_lobe, sample_phong_lobe
 
