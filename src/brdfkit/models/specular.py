@@ -47,10 +47,10 @@ from brdfkit.errors import ParameterError
 
 __all__ = ["specular_integral", "specular_integral_with_error", "blinn_normal_albedo"]
 
-#: Rounding allowance of the error estimate, in units of the float64 epsilon times the
-#: sum of the magnitudes of the terms: each node's value carries a relative error of a
-#: few ulps, amplified up to ~_DECAY (the largest n·|log cos α| kept) by the power n.
+#: Rounding allowance of the error estimate, in units of the float64 epsilon times the sum
+#: of the magnitudes of the terms; the power n adds n of them (see :func:`_error`).
 _ROUNDING = 128.0 * np.finfo(np.float64).eps
+_EPS = float(np.finfo(np.float64).eps)
 
 def blinn_normal_albedo(n):
     """∫ (N·H)ⁿ cos θ_o dω_o at normal incidence (L = N), in closed form.
@@ -123,7 +123,10 @@ def _hs_phong(theta: np.ndarray, n: float) -> tuple[np.ndarray, np.ndarray]:
         lobe = np.exp(n * np.log(cos_a))
     terms = _TS_W * lobe * g * sin_a
     part = length[:, 0] * np.sum(terms, axis=-1)
-    return closed[:, 0] + part, _error(closed[:, 0], length[:, 0], terms, part)
+    # d closed / d log s: what the rounding of log s (~ε absolute) moves it by
+    with np.errstate(under="ignore"):
+        slope = 2.0 * np.pi * c * np.exp((n + 2.0) * log_s)
+    return closed[:, 0] + part, _error(closed[:, 0], slope[:, 0], length[:, 0], terms, part, n)
 
 
 def _hs_blinn(theta: np.ndarray, n: float) -> tuple[np.ndarray, np.ndarray]:
@@ -167,19 +170,30 @@ def _hs_blinn(theta: np.ndarray, n: float) -> tuple[np.ndarray, np.ndarray]:
         lobe = np.exp(n * np.log(h))
     terms = _TS_W * lobe * ring * sg
     part = length[:, 0] * np.sum(terms, axis=-1)
-    return full[:, 0] + part, _error(full[:, 0], length[:, 0], terms, part)
+    # d full / d log h₁: what the rounding of log h₁ (~ε absolute) moves it by
+    with np.errstate(under="ignore"):
+        slope = ((16.0 * np.pi * c * c - 8.0 * np.pi * s * s) * np.exp((n + 4.0) * log_h1)
+                 + (8.0 * np.pi * s * s - 8.0 * np.pi * c * c) * np.exp((n + 2.0) * log_h1))
+    return full[:, 0] + part, _error(full[:, 0], slope[:, 0], length[:, 0], terms, part, n)
 
 
-def _error(closed: np.ndarray, length: np.ndarray, terms: np.ndarray,
-           part: np.ndarray) -> np.ndarray:
+def _error(closed: np.ndarray, slope: np.ndarray, length: np.ndarray, terms: np.ndarray,
+           part: np.ndarray, n: float) -> np.ndarray:
     """|I_h − I_2h| (the rule on every other node, weights doubled) plus rounding.
 
     Tanh-sinh converges double exponentially (error(h) ≈ error(2h)²), so the
     difference from the coarser rule bounds the error of the finer one.
+    Rounding: every value carries a few ulps (:data:`_ROUNDING`), and a power
+    xⁿ = exp(n log x) of a cosine x near 1 turns the absolute rounding of x
+    (~ε) into an error n·ε relative to the lobe at each node, and into
+    ε·|*slope*| in the closed-form part (*slope*: its derivative with respect
+    to the logarithm it raises to the power). Checked against 25-digit
+    references up to n = 1e6 (``tests/test_models_phong.py``).
     """
     coarse = length * np.sum(2.0 * terms[:, ::2], axis=-1)
-    size = np.abs(closed) + length * np.sum(np.abs(terms), axis=-1)
-    return np.abs(part - coarse) + _ROUNDING * size
+    nodes = length * np.sum(np.abs(terms), axis=-1)
+    return (np.abs(part - coarse) + _ROUNDING * (np.abs(closed) + nodes) + n * _EPS * nodes
+            + 8.0 * _EPS * np.abs(slope))
 
 
 def specular_integral(theta_i, n: float, lobe: str = "phong") -> np.ndarray:
