@@ -184,6 +184,88 @@ def test_specular_integral_zero_exponent_and_validation():
         specular_integral(0.1, 1.0, "ward")
 
 
+# Registered models whose BRDF is Lewis's F_s itself (no 1/(N·S)): Lafortune's lobe with
+# C_xy = −1, C_z = 1 is max(0, R·V)ⁿ (shown in test_lafortune_mirror_coefficients_give_phong_lobe)
+# and the reciprocal Phong–Blinn with k_d = 0, k_s = 1 is (N·H)ⁿ (eq. 24).
+def fs_model(lobe, n):
+    if lobe == "phong":
+        return brdfkit.model("lafortune", rho_d=0.0, rho_s=1.0, C_xy=-1.0, C_z=1.0, n=n)
+    return brdfkit.model("phong-blinn-reciprocal", k_d=0.0, k_s=1.0, n=n)
+
+
+@pytest.mark.parametrize("lobe", ["phong", "blinn"])
+@pytest.mark.parametrize("n", [0.0, 3.0, 50.0, 2000.0])
+def test_H_s_against_the_albedo_engine(lobe, n):
+    # Two independent methods: H_s (closed-form azimuth + tanh-sinh, models.specular) and
+    # the albedo engine's lobe-frame Gauss–Kronrod over a registered model equal to F_s.
+    from brdfkit.analysis import H_s
+    from brdfkit.analysis import albedo as engine
+
+    th = np.radians([0.0, 20.0, 50.0, 75.0, 85.0, 89.0, 89.9])
+    hs = H_s(th, n, lobe=lobe)
+    ref = engine(fs_model(lobe, n), th, tol=1e-10)
+    np.testing.assert_allclose(hs.albedo, ref.albedo, rtol=0, atol=1e-9)
+    # each method's error estimate covers the difference between the two
+    assert np.all(np.abs(hs.albedo - ref.albedo) <= hs.error + ref.error + 1e-15)
+    np.testing.assert_array_equal(hs.albedo, specular_integral(th, n, lobe))  # the one H_s
+
+
+# H_s to 25 digits by mpmath (closed-form azimuth as in models.specular, the polar integral
+# by mpmath's tanh-sinh, panels at the lobe scale); independent of float64 rounding.
+H_S_25_DIGITS = [
+    ("phong", 1e4, 1.5697963267948967, 2.832680678942615174783852e-6),
+    ("phong", 1e4, 1.5707, 2.536436566816404401640749e-6),
+    ("phong", 1e6, 1.5697963267948967, 6.806656593296028447356268e-9),
+    ("phong", 1e6, 1.5707, 2.820861885819349964057917e-9),
+    ("phong", 1e6, 0.3, 6.002544186798164958732352e-6),
+    ("blinn", 20.0, 1.5697963267948967, 0.04785192611441420299644334),
+    ("blinn", 1e4, 1.5697963267948967, 2.825139228951083325211351e-7),
+    ("blinn", 1e6, 1.5697963267948967, 6.983130257470212330429058e-11),
+]
+
+
+@pytest.mark.parametrize("lobe,n,theta,ref", H_S_25_DIGITS)
+def test_H_s_error_estimate_bounds_the_error(lobe, n, theta, ref):
+    from brdfkit.models.specular import specular_integral_with_error
+
+    v, e = specular_integral_with_error(theta, n, lobe)
+    assert abs(v - ref) <= e
+    assert e <= 2e-9 * ref  # and stays useful (≤ n·ε relative: pessimistic, but a bound)
+
+
+@pytest.mark.parametrize("n", [1.0, 20.0, 1000.0, 1e6])
+def test_H_s_error_estimate_at_closed_forms(n):
+    from brdfkit.analysis import H_s
+
+    # Lewis eq. (16) at θ_i = 0 and the grazing Blinn closed form (see above)
+    r = H_s(np.array([0.0]), n, lobe="phong")
+    assert abs(r.albedo[0] - 2 * math.pi / (n + 2)) <= r.error[0]
+    r = H_s(np.array([0.5 * math.pi - 1e-15]), n, lobe="blinn")
+    assert abs(r.albedo[0] - 8 * math.pi / ((n + 2) * (n + 4))) <= r.error[0] + 1e-13 * r.albedo[0]
+    with pytest.raises(ParameterError, match="theta_i"):
+        H_s(0.5 * math.pi, n)  # as every albedo: θ_i in [0, π/2)
+    with pytest.raises(ParameterError, match="tol"):
+        H_s(0.1, n, tol=0.0)
+
+
+def test_moved_names_still_import_from_phong():
+    # the split keeps `from brdfkit.models.phong import X` working for every public name
+    from brdfkit.models import blinn, grazing, lafortune, sampling
+    from brdfkit.models import phong as ph
+
+    assert ph.Nielsen is grazing.Nielsen and ph.NeumannPhong is grazing.NeumannPhong
+    assert ph.Lafortune is lafortune.Lafortune
+    assert ph.PhongBlinnReciprocal is blinn.PhongBlinnReciprocal
+    assert ph.NHPowerSeries is blinn.NHPowerSeries
+    assert ph.ModifiedBlinnPhong is blinn.ModifiedBlinnPhong
+    assert ph.sample_phong_lobe is sampling.sample_phong_lobe
+    for name in ("lobe_pow", "blinn_normal_albedo", "specular_integral", "pdf_phong_lobe",
+                 "sample_blinn_lobe", "pdf_blinn_lobe", "diffuse_fraction", "split_uniform"):
+        assert callable(getattr(ph, name)), name
+    with pytest.raises(AttributeError):
+        ph.NoSuchModel  # noqa: B018
+
+
 @pytest.mark.parametrize("lobe", ["phong", "blinn"])
 @pytest.mark.parametrize("theta_deg", [0.0, 45.0, 80.0, 89.0])
 def test_energy_conserving_phong_albedo_equals_k_rho(lobe, theta_deg):
@@ -418,7 +500,7 @@ def test_beta_gives_half_maximum_exponent(name):
 
 @pytest.mark.parametrize("name", [n for n in PHONG_FAMILY if brdfkit.MODELS[n].has_sampler])
 def test_sampler_follows_its_pdf(name):
-    chi2 = pytest.importorskip("brdfkit.chi2")
+    chi2 = pytest.importorskip("brdfkit.analysis.chi2")
     cls = brdfkit.MODELS[name]
     for ex in cls.examples[:2]:
         m = cls(**ex)

@@ -1,4 +1,4 @@
-"""χ² goodness-of-fit of every model's sampler against its pdf (:mod:`brdfkit.chi2`).
+"""χ² goodness-of-fit of every model's sampler against its pdf (:mod:`brdfkit.analysis.chi2`).
 
 Every registered model × each of its ``examples`` × θ_o ∈ {0°, 30°, 60°, 80°,
 85°, 89°} (azimuth 23°, so no symmetry of the frame helps). The reference is
@@ -6,6 +6,10 @@ the model's own ``pdf``, integrated over each bin by quadrature; the overall
 significance of the run is α = 0.01, split over all tests here by the Šidák
 correction. Models without a dedicated sampler are tested through the base
 class's cosine fallback.
+
+The strategies of :mod:`brdfkit.models.sampling` are also tested alone: every
+one mixed (with per-wo weights) into one sampler, their normalisation, and the
+half-vector distributions against the microfacet samplers they will replace.
 
 Tests of the test: a modified-Phong pdf whose normalisation uses n+2 instead of
 n+1, a sampler drawing cosⁿ⁺¹ while the pdf claims cosⁿ, a sampler that
@@ -25,9 +29,24 @@ import numpy as np
 import pytest
 
 import brdfkit
-from brdfkit.chi2 import SphereBinning, chi2_test, sidak_alpha
+from brdfkit.analysis.chi2 import SphereBinning, chi2_test, sidak_alpha
 from brdfkit.geometry import pdf_cosine_hemisphere, reflect, sample_cosine_hemisphere
+from brdfkit.models import Lobe
+from brdfkit.models.diffuse import Lambert
 from brdfkit.models.phong import ModifiedPhong, pdf_phong_lobe, sample_phong_lobe
+from brdfkit.models.sampling import (
+    COSINE,
+    BeckmannHalf,
+    CosPowerAxis,
+    CosPowerNormal,
+    GGXHalf,
+    HalfVector,
+    Mixture,
+    PowerHalf,
+    StrategySampled,
+    blinn_lobe,
+    phong_lobe,
+)
 
 THETAS_DEG = (0.0, 30.0, 60.0, 80.0, 85.0, 89.0)
 PHI_O = math.radians(23.0)
@@ -188,3 +207,80 @@ def test_correct_reference_passes():
     r = chi2_test(ModifiedPhong(rho_d=0.3, rho_s=0.5, n=20.0), wo_at(30.0),
                   n_samples=N_SAMPLES, seed=1, alpha=ALPHA, n_tests=N_TESTS)
     assert r.passed, r.message
+
+
+# --------------------------------------------------------------------------- the strategies
+class StrategyMix(StrategySampled, Lambert):
+    """Lambert's f with a sampler mixing every strategy of brdfkit.models.sampling, with
+    weights that depend on wo: the χ² test checks the mixture's sample() against its pdf()."""
+
+    def lobes(self):
+        return [Lobe("half", 0.1)]
+
+    def _strategy(self, wo):
+        w_half = 0.2 + 0.3 * wo[..., 2]  # per-wo weights
+        w = np.stack([0.2 + 0 * w_half, 0.15 + 0 * w_half, w_half, 0.65 - w_half - 0.0], -1)
+        w = w / np.sum(w, axis=-1, keepdims=True)
+        return Mixture([COSINE, CosPowerNormal(3.0), HalfVector(GGXHalf(0.2)),
+                        Mixture([phong_lobe(40.0), blinn_lobe(200.0),
+                                 HalfVector(BeckmannHalf(0.1))], [0.5, 0.3, 0.2])], w)
+
+
+@pytest.mark.parametrize("theta", [0.0, 45.0, 85.0])
+def test_every_strategy_in_a_mixture_passes(theta):
+    r = chi2_test(StrategyMix(), wo_at(theta), n_samples=N_SAMPLES, seed=seed_for("mix", theta),
+                  alpha=ALPHA, n_tests=N_TESTS)
+    assert r.passed, r.message
+
+
+@pytest.mark.parametrize("strategy", [COSINE, CosPowerNormal(0.5), CosPowerAxis(300.0),
+                                      HalfVector(PowerHalf(50.0)), HalfVector(GGXHalf(0.3)),
+                                      HalfVector(BeckmannHalf(0.05))], ids=repr)
+def test_strategy_densities_integrate_to_one(strategy):
+    # Over the whole sphere (directions below the horizon included): each is a density.
+    wo = wo_at(60.0)
+    b = SphereBinning(reflect(wo), 0.1, 40, 32)
+    total, _ = b.integrate(lambda w: strategy.pdf(w, np.broadcast_to(wo, w.shape)),
+                           max_depth=5, must_refine=b.straddles_horizon)
+    tol = 2e-3 if isinstance(strategy, HalfVector) else 1e-6  # the 1/(4|wo·h|) point at −wo
+    assert total.sum() == pytest.approx(1.0, abs=tol)
+
+
+def test_half_vector_distributions_match_the_microfacet_samplers():
+    # sampling.HalfVector(...) is what microfacet's half-vector sampler will move onto:
+    # the same normals from the same u, the same densities (fold=False: its convention).
+    from brdfkit.models.microfacet import pdf_half_vector, sample_half_vector
+
+    u = np.random.default_rng(5).random((5000, 2))
+    for kind, dist in (("beckmann", BeckmannHalf(0.2)), ("ggx", GGXHalf(0.3)),
+                       ("phong", PowerHalf(40.0))):
+        width = {"beckmann": 0.2, "ggx": 0.3, "phong": 40.0}[kind]
+        np.testing.assert_array_equal(dist.sample_h(u), sample_half_vector(kind, width, u))
+        c = np.linspace(-0.1, 1.0, 1001)
+        np.testing.assert_allclose(dist.pdf_h(c), pdf_half_vector(kind, width, c),
+                                   rtol=1e-13, atol=0)
+    wo = wo_at(50.0)
+    wi = HalfVector(GGXHalf(0.3), fold=False).sample(wo, u)
+    h = (wi + wo) / np.linalg.norm(wi + wo, axis=-1, keepdims=True)
+    expected = np.where(h[:, 2] > 0.0, pdf_half_vector("ggx", 0.3, h[:, 2])
+                        / (4.0 * np.abs(h @ wo)), 0.0)
+    np.testing.assert_allclose(HalfVector(GGXHalf(0.3), fold=False).pdf(wi, wo), expected,
+                               rtol=1e-12)
+
+
+def test_mixture_consumes_one_uniform_pair_per_sample():
+    # A one-component mixture draws exactly what the component draws from the same u, and
+    # the modified-Phong sampler is the mixture of the cosine and the lobe (diffuse first).
+    wo = wo_at(30.0)
+    u = np.random.default_rng(6).random((4000, 2))
+    lobe = phong_lobe(25.0)
+    np.testing.assert_array_equal(Mixture([lobe], [1.0]).sample(wo, u), lobe.sample(wo, u))
+    m = ModifiedPhong(rho_d=0.3, rho_s=0.3, n=25.0)  # p_d = 1/2
+    wi, _ = m.sample(wo, u)
+    first = u[:, 0] < 0.5
+    ud = np.stack([2.0 * u[first, 0], u[first, 1]], -1)
+    us = np.stack([2.0 * u[~first, 0] - 1.0, u[~first, 1]], -1)
+    np.testing.assert_allclose(wi[first], COSINE.sample(wo, ud), rtol=1e-12)
+    np.testing.assert_allclose(wi[~first], lobe.sample(wo, us), rtol=1e-12, atol=1e-15)
+    # exponent 0: the lobe is constant, sampled by the cosine (the pdf integrates to 1)
+    assert phong_lobe(0.0) is COSINE and blinn_lobe(0.0) is COSINE

@@ -641,50 +641,16 @@ def hemispherical_albedo(model, *, n: int = 48, tol: float = 1e-7) -> tuple[np.n
     return v1, err
 
 
-@numba.njit(cache=True)
-def _fs_phong(ix, iy, iz, ox, oy, oz, p):
-    """Lewis eq. (5): F_s^P = max(0, R·V)^n (no 1/(N·S): H_s is the integral of F_s)."""
-    if iz <= 0.0 or oz <= 0.0:
-        return 0.0
-    rv = 2.0 * iz * oz - (ix * ox + iy * oy + iz * oz)
-    return rv ** p[0] if rv > 0.0 else (1.0 if p[0] == 0.0 else 0.0)
-
-
-@numba.njit(cache=True)
-def _fs_blinn(ix, iy, iz, ox, oy, oz, p):
-    """Lewis eq. (6): F_s^B = (N·H)^n."""
-    if iz <= 0.0 or oz <= 0.0:
-        return 0.0
-    hx = ix + ox
-    hy = iy + oy
-    hz = iz + oz
-    ln = math.sqrt(hx * hx + hy * hy + hz * hz)
-    if ln <= 1e-300:
-        return 0.0
-    return (hz / ln) ** p[0]
-
-
-class _SpecularIntegrand:
-    """Lewis's F_s as a kernel-carrying object for :func:`albedo` (not a registered model)."""
-
-    isotropic = True
-    n_channels = None
-
-    def __init__(self, n: float, lobe: str):
-        from brdfkit.halfangle import beta_from_exponent
-        from brdfkit.models import Lobe
-
-        self.kernel = _fs_phong if lobe == "phong" else _fs_blinn
-        self.packed = np.array([[float(n)]])
-        w = float(beta_from_exponent(n)) if n > 0 else math.pi / 2
-        self._lobes = [Lobe("mirror" if lobe == "phong" else "half", w)]
-
-    def lobes(self):
-        return self._lobes
-
-
 def H_s(theta_i, n: float, *, lobe: str = "phong", tol: float = 1e-8) -> AlbedoResult:
     """Lewis's specular integral H_s(S) = ∫ F_s(S, V) (N·V) dω_V (§4.1, Fig. 5).
+
+    The albedo of Lewis's specular function alone, computed by the one H_s
+    implementation, :func:`brdfkit.models.specular.specular_integral_with_error`
+    (azimuth in closed form, tanh-sinh in the polar angle; ~1e-11 relative),
+    not by the albedo engine. (The engine gives the same numbers for the
+    registered models whose BRDF is F_s itself: ``lafortune`` with ρ_d = 0,
+    ρ_s = 1, C_xy = −1, C_z = 1 is F_s^P, ``phong-blinn-reciprocal`` with
+    k_d = 0, k_s = 1 is F_s^B; the tests compare the two.)
 
     Parameters
     ----------
@@ -694,16 +660,28 @@ def H_s(theta_i, n: float, *, lobe: str = "phong", tol: float = 1e-8) -> AlbedoR
         Specular exponent n_s ≥ 0.
     lobe : {"phong", "blinn"}, keyword-only
         F_s^P = max(0, R·V)^n (eq. 5) or F_s^B = (N·H)^n (eq. 6).
+    tol : float, keyword-only
+        Absolute accuracy goal (> 0). The quadrature's own accuracy (~1e-11
+        relative, H_s ≤ π) meets any goal above ~1e-10; ``error`` states what
+        was reached.
 
     Returns
     -------
     AlbedoResult
-        ``albedo`` holds H_s. Lewis eq. (19): k_ρ = k_d π + k_s H_s/(N·S).
-        At θ_i = 0 with the Phong lobe, H_s = 2π/(n + 2) (eq. 16 with γ = n + 1).
+        ``albedo`` holds H_s, ``error`` its absolute error estimate (the
+        difference from the rule of twice the step plus rounding, a bound in
+        practice). Lewis eq. (19): k_ρ = k_d π + k_s H_s/(N·S). At θ_i = 0
+        with the Phong lobe, H_s = 2π/(n + 2) (eq. 16 with γ = n + 1).
     """
+    # imported here: the rest of this module is the engine and does not need it
+    from brdfkit.models.specular import specular_integral_with_error
+
     if lobe not in ("phong", "blinn"):
         raise ParameterError(f"lobe must be 'phong' or 'blinn'; got {lobe!r}")
     n = float(n)
     if not (n >= 0.0 and math.isfinite(n)):
         raise ParameterError(f"n must be a finite number >= 0; got {n!r}")
-    return albedo(_SpecularIntegrand(n, lobe), theta_i, tol=tol)
+    th = _check_theta(theta_i)
+    _check_tol(tol)
+    value, error = specular_integral_with_error(th, n, lobe)
+    return AlbedoResult(theta=th.copy(), albedo=value, error=error)

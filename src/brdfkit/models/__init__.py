@@ -5,9 +5,18 @@ Reflectance models
 One module per family; every model is registered in :data:`MODELS`.
 
 - :mod:`~brdfkit.models.diffuse` — Lambert, Neumann–Neumann, Minnaert.
-- :mod:`~brdfkit.models.phong` — the Phong family of all three papers.
+- :mod:`~brdfkit.models.phong` — normalised Phong and Lewis's Phong, Blinn and
+  energy-conserving shaders (R·V lobes, and N·H divided by N·L).
+- :mod:`~brdfkit.models.blinn` — reciprocal N·H lobes: Lewis's reciprocal
+  Phong–Blinn and N·H power series, Nielsen's modified Blinn–Phong.
+- :mod:`~brdfkit.models.lafortune` — Lafortune's generalised cosine lobes.
+- :mod:`~brdfkit.models.grazing` — Neumann et al.'s eq. (22) and Nielsen et
+  al.'s eq. (3), Phong variants for grazing angles.
 - :mod:`~brdfkit.models.microfacet` — Torrance–Sparrow, Cook–Torrance, Ward,
   He–Torrance and the modern Walter et al. microfacet model.
+
+Shared by the families: :mod:`~brdfkit.models.sampling` (importance-sampling
+strategies), :mod:`~brdfkit.models.specular` (Lewis's H_s).
 """
 
 from brdfkit.models._base import BRDF, DerivedBRDF, Lobe, Param, eval_pairs
@@ -16,8 +25,8 @@ from brdfkit.models._registry import MODELS, model, model_names, register, resol
 # Importing the family modules registers their models, in this order: the order of
 # `brdfkit models`, of the README's model table and of Table 2.
 # isort: off
-from brdfkit.models import diffuse, phong, microfacet  # noqa: E402,F401
+from brdfkit.models import diffuse, phong, blinn, lafortune, grazing, microfacet  # noqa: E402,F401,I001
 # isort: on
 
-__all__ = ["BRDF", "DerivedBRDF", "Lobe", "MODELS", "Param", "eval_pairs", "model", "model_names", "register",
-           "resolve"]
+__all__ = ["BRDF", "DerivedBRDF", "Lobe", "MODELS", "Param", "eval_pairs", "model", "model_names",
+           "register", "resolve"]

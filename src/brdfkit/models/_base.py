@@ -46,7 +46,7 @@ import numpy as np
 
 from brdfkit._array import as_directions, as_uniform
 from brdfkit.errors import BrdfkitError, ParameterError
-from brdfkit.geometry import pdf_cosine_hemisphere, sample_cosine_hemisphere
+from brdfkit.models.sampling import COSINE
 
 __all__ = ["Param", "Lobe", "BRDF", "DerivedBRDF", "checked_driver", "eval_pairs",
            "eval_pairs_checked"]
@@ -614,7 +614,7 @@ class BRDF:
         """
         wo = as_directions(wo, "wo")
         u = as_uniform(u)
-        wi = sample_cosine_hemisphere(u)
+        wi = COSINE.sample(wo, u)
         wi = np.broadcast_to(wi, np.broadcast_shapes(wi.shape, wo.shape)).copy()
         return wi, self.pdf(wi, wo)
 
@@ -622,7 +622,7 @@ class BRDF:
         """Solid-angle density of :meth:`sample` for wi given wo."""
         wi = as_directions(wi, "wi")
         wo = as_directions(wo, "wo")
-        p = pdf_cosine_hemisphere(wi)
+        p = COSINE.pdf(wi, wo)
         return np.where(wo[..., 2] > 0.0, p, 0.0) * np.ones(np.broadcast_shapes(
             wi.shape, wo.shape)[:-1])
 

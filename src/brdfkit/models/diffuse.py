@@ -24,9 +24,7 @@ from __future__ import annotations
 import math
 
 import numba
-import numpy as np
 
-from brdfkit._array import as_directions, as_uniform, stack
 from brdfkit._kern import INV_PI, INV_TWO_PI, below_horizon
 from brdfkit.halfangle import (
     beta_from_minnaert_k,
@@ -36,6 +34,7 @@ from brdfkit.halfangle import (
 )
 from brdfkit.models._base import BRDF, Lobe, Param
 from brdfkit.models._registry import register
+from brdfkit.models.sampling import CosPowerNormal, StrategySampled
 
 RHO_D = Param("rho_d", 0.8, 0.0, 1.0, "", "diffuse albedo (fraction of irradiance reflected)",
               kind="colour")
@@ -85,7 +84,7 @@ def _neumann_neumann(ix, iy, iz, ox, oy, oz, p):
 
 
 @register
-class NeumannNeumann(BRDF):
+class NeumannNeumann(StrategySampled, BRDF):
     """Neumann–Neumann "lacquer" model as written by Lewis §3.3.
 
     f_r(S, V) = b_N exp{−s (1/(N·S) + 1/(N·V) − 2)}: a diffuse base under an
@@ -144,11 +143,8 @@ class NeumannNeumann(BRDF):
         s = float(self._values["s"])
         return [Lobe("normal", beta_from_neumann_s(s) if s > 0.0 else math.pi / 2)]
 
-    def sample(self, wo, u):
-        return _sample_cos_power(self, float(self._values["s"]) + 1.0, wo, u)
-
-    def pdf(self, wi, wo):
-        return _pdf_cos_power(float(self._values["s"]) + 1.0, wi, wo)
+    def _strategy(self, wo):
+        return CosPowerNormal(float(self._values["s"]) + 1.0)
 
 
 # --------------------------------------------------------------------------- Minnaert
@@ -185,42 +181,6 @@ def _minnaert_ec(ix, iy, iz, ox, oy, oz, p):
     return k_rho * (k + 1.0) * INV_TWO_PI * _minnaert_core(iz, oz, k)
 
 
-def _sample_cos_power(model, q, wo, u):
-    """wi with density (q+1)/(2π) cos^q θ_i (q > −1): cos θ = u₀^{1/(q+1)} (inverse CDF)."""
-    wo = as_directions(wo, "wo")
-    u = as_uniform(u)
-    cos_t = u[..., 0] ** (1.0 / (q + 1.0))
-    sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))  # clamp: rounding at cos_t = 1
-    phi = 2.0 * np.pi * u[..., 1]
-    wi = stack(sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t)
-    wi = np.broadcast_to(wi, np.broadcast_shapes(wi.shape, wo.shape)).copy()
-    return wi, model.pdf(wi, wo)
-
-
-def _pdf_cos_power(q, wi, wo):
-    """Density of :func:`_sample_cos_power`; 0 below the horizon or when wo is below it."""
-    wi = as_directions(wi, "wi")
-    wo = as_directions(wo, "wo")
-    c = wi[..., 2]
-    with np.errstate(divide="ignore"):
-        p = (q + 1.0) / (2.0 * np.pi) * np.where(c > 0.0, c, 1.0) ** q
-    p = np.where(c > 0.0, p, 0.0)
-    return np.where(wo[..., 2] > 0.0, p, 0.0)
-
-
-def _sample_minnaert(model, wo, u):
-    """Exact importance sampling of Minnaert: f cos θ_i ∝ cos^k θ_i for fixed wo.
-
-    So wi is drawn with density (k+1)/(2π) cos^k θ_i and f cos θ_i / pdf does
-    not depend on wi.
-    """
-    return _sample_cos_power(model, float(model._values["k"]), wo, u)
-
-
-def _pdf_minnaert(model, wi, wo):
-    return _pdf_cos_power(float(model._values["k"]), wi, wo)
-
-
 def _minnaert_lobes(k: float) -> list:
     return [Lobe("normal", beta_from_minnaert_k(k) if k > 1.0 else math.pi / 2)]
 
@@ -231,7 +191,7 @@ K_MINNAERT = Param("k", 2.0, 0.0, 1e7, "",
 
 
 @register
-class Minnaert(BRDF):
+class Minnaert(StrategySampled, BRDF):
     """Minnaert's lunar shader as a BRDF (Lewis §3.4).
 
     f_r(S, V) = b_M ((N·S)(N·V))^{k−1}, from L_r = b_M (N·S)^k (N·V)^{k−1} L_i
@@ -280,15 +240,13 @@ class Minnaert(BRDF):
     def lobes(self):
         return _minnaert_lobes(float(self._values["k"]))
 
-    def sample(self, wo, u):
-        return _sample_minnaert(self, wo, u)
-
-    def pdf(self, wi, wo):
-        return _pdf_minnaert(self, wi, wo)
+    def _strategy(self, wo):
+        # exact: f cos θ_i ∝ cos^k θ_i for fixed wo, so f cos θ_i / pdf does not depend on wi
+        return CosPowerNormal(float(self._values["k"]))
 
 
 @register
-class MinnaertEnergyConserving(BRDF):
+class MinnaertEnergyConserving(StrategySampled, BRDF):
     """Energy-normalised Minnaert shader (Lewis §4.3).
 
     f_r(S, V) = k_ρ (k+1)/(2π) ((N·S)(N·V))^{k−1}.
@@ -339,8 +297,6 @@ class MinnaertEnergyConserving(BRDF):
     def lobes(self):
         return _minnaert_lobes(float(self._values["k"]))
 
-    def sample(self, wo, u):
-        return _sample_minnaert(self, wo, u)
-
-    def pdf(self, wi, wo):
-        return _pdf_minnaert(self, wi, wo)
+    def _strategy(self, wo):
+        # exact: f cos θ_i ∝ cos^k θ_i for fixed wo, so f cos θ_i / pdf does not depend on wi
+        return CosPowerNormal(float(self._values["k"]))

@@ -1,0 +1,476 @@
+"""
+Importance-sampling strategies
+==============================
+
+One set of composable strategies from which the models' :meth:`~brdfkit.models.BRDF.sample`
+and :meth:`~brdfkit.models.BRDF.pdf` are built. A strategy draws ω_i for given
+ω_o from two uniform numbers per sample and states the solid-angle density of
+what it draws over the *whole sphere* of ω_i (a strategy may draw directions
+below the horizon; the BRDF is 0 there and the caller discards them):
+
+- :class:`Cosine` — cos θ_i/π about the normal (Malley's method); the
+  fallback of :class:`~brdfkit.models.BRDF`.
+- :class:`CosPowerNormal` — (q+1)/(2π) cos^q θ_i about the normal (q > −1),
+  upper hemisphere: separable models peaked at the normal (Minnaert,
+  Neumann–Neumann).
+- :class:`CosPowerAxis` — (n+1)/(2π) max(0, cos α)ⁿ about an axis that
+  depends on ω_o: the mirror direction of ω_o (Phong's R·V lobe) or any other
+  (Lafortune's (C_xy o_x, C_xy o_y, C_z o_z)).
+- :class:`HalfVector` — a half vector h drawn about the normal from a
+  :class:`HalfVectorDistribution`, ω_i the mirror of ω_o about h; density
+  p_h(h)/(4|ω_o·h|) (the Jacobian of ω_i = 2(ω_o·h)h − ω_o). Distributions:
+  :class:`PowerHalf` ((N·H)ⁿ, Blinn), :class:`BeckmannHalf` and
+  :class:`GGXHalf` (microfacet normals, Walter et al. 2007).
+- :class:`Mixture` — Σ_k w_k p_k with weights that may depend on ω_o.
+
+:func:`phong_lobe` and :func:`blinn_lobe` build the lobe strategies (the
+cosine for exponent 0, where the lobe is constant: 0⁰ = 1).
+
+A model uses them through the mixin :class:`StrategySampled`: it defines
+``_strategy(wo) -> Strategy``; ``sample`` and ``pdf`` validate their
+arguments, draw, and give density 0 when ω_o is below the horizon.
+
+Random numbers: every strategy reads exactly (u₀, u₁) per sample. A
+:class:`Mixture` picks component k from u₀ (the first k whose cumulative
+weight exceeds u₀) and rescales u₀ to [0, 1) within that component's
+interval, so a mixture consumes the same stream as one strategy.
+
+Lower-level functions (arrays in, arrays out, no validation):
+:func:`sample_phong_lobe`, :func:`pdf_phong_lobe` (cosⁿ about an axis),
+:func:`sample_blinn_lobe`, :func:`pdf_blinn_lobe` (N·H power through the
+half vector), :func:`diffuse_fraction`, :func:`split_uniform`,
+:func:`normalised_weights`, :func:`log_mixture_weights`.
+
+References
+----------
+- T. Malley, 1988 (cosine sampling by lifting the unit disk).
+- [Lafortune1994] E. P. Lafortune, Y. D. Willems, *Using the modified Phong
+  reflectance model for physically based rendering*, 1994 (cosⁿ lobe sampling).
+- [Walter2007] B. Walter et al., *Microfacet Models for Refraction through
+  Rough Surfaces*, EGSR 2007, eqs. (28), (35), (14) (half-vector sampling and
+  its Jacobian).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from brdfkit._array import as_directions, as_uniform, stack
+from brdfkit.geometry import (
+    local_to_world,
+    pdf_cosine_hemisphere,
+    reflect,
+    sample_cosine_hemisphere,
+)
+
+__all__ = [
+    "Strategy", "Cosine", "COSINE", "CosPowerNormal", "CosPowerAxis", "HalfVector",
+    "HalfVectorDistribution", "PowerHalf", "BeckmannHalf", "GGXHalf", "Mixture",
+    "StrategySampled", "phong_lobe", "blinn_lobe", "sample_phong_lobe", "pdf_phong_lobe",
+    "sample_blinn_lobe", "pdf_blinn_lobe", "diffuse_fraction", "split_uniform",
+    "normalised_weights", "log_mixture_weights",
+]
+
+_NORMAL = np.array([0.0, 0.0, 1.0])
+
+
+# --------------------------------------------------------------------------- functions
+def sample_phong_lobe(axis: np.ndarray, n: float, u: np.ndarray) -> np.ndarray:
+    """Direction about *axis* with density (n+1)/(2π) cosⁿα on the sphere.
+
+    Inverting the CDF of cosⁿα sinα gives cos α = u₀^{1/(n+1)}.
+    """
+    cos_a = u[..., 0] ** (1.0 / (n + 1.0))
+    sin_a = np.sqrt(np.maximum(0.0, 1.0 - cos_a * cos_a))  # clamp: rounding near cos_a = 1
+    phi = 2.0 * np.pi * u[..., 1]
+    local = stack(sin_a * np.cos(phi), sin_a * np.sin(phi), cos_a)
+    return local_to_world(local, axis)
+
+
+def pdf_phong_lobe(cos_alpha: np.ndarray, n: float) -> np.ndarray:
+    """Density of :func:`sample_phong_lobe`, (n+1)/(2π) max(0, cos α)ⁿ."""
+    return (n + 1.0) / (2.0 * np.pi) * np.maximum(cos_alpha, 0.0) ** n
+
+
+def sample_blinn_lobe(wo: np.ndarray, n: float, u: np.ndarray) -> np.ndarray:
+    """wi = mirror of *wo* about h, h drawn about the normal with density (n+1)/(2π) cosⁿθ_h.
+
+    The map h ↦ wi = 2(wo·h)h − wo has Jacobian dω_i/dω_h = 4|wo·h|, so wi has
+    density p_h/(4|wo·h|) (:func:`pdf_blinn_lobe`). Where wo·h < 0 the
+    direction lands below the horizon (the BRDF is 0 there).
+    """
+    return HalfVector(PowerHalf(n)).sample(wo, u)
+
+
+def pdf_blinn_lobe(wi: np.ndarray, wo: np.ndarray, n: float) -> np.ndarray:
+    """Solid-angle density of :func:`sample_blinn_lobe` over the full sphere of wi."""
+    return HalfVector(PowerHalf(n)).pdf(wi, wo)
+
+
+def diffuse_fraction(rho_d, rho_s) -> float:
+    """Probability of picking the diffuse lobe in a diffuse + specular mixture.
+
+    Proportional to the channel-mean reflectances; 1/2 when both are zero.
+    """
+    d = float(np.mean(rho_d))
+    s = float(np.mean(rho_s))
+    return 0.5 if d + s <= 0.0 else d / (d + s)
+
+
+def split_uniform(u0: np.ndarray, p: float) -> tuple[np.ndarray, np.ndarray]:
+    """Pick the first lobe where u₀ < p and rescale u₀ to [0, 1) in both branches."""
+    first = u0 < p
+    if p <= 0.0:
+        return np.zeros_like(u0, dtype=bool), u0
+    if p >= 1.0:
+        return np.ones_like(u0, dtype=bool), u0
+    return first, np.where(first, u0 / p, (u0 - p) / (1.0 - p))
+
+
+def normalised_weights(weights) -> np.ndarray:
+    """Mixture weights: negative ones clipped to 0, scaled to sum 1 (all equal if none > 0)."""
+    w = np.maximum(np.asarray(weights, dtype=np.float64), 0.0)
+    s = float(np.sum(w))
+    return np.full(w.shape, 1.0 / w.size) if s <= 0.0 else w / s
+
+
+def _shape(wo: np.ndarray, u: np.ndarray) -> tuple[int, ...]:
+    return np.broadcast_shapes(wo.shape[:-1], u.shape[:-1])
+
+
+# --------------------------------------------------------------------------- strategies
+class Strategy:
+    """A sampling strategy: :meth:`sample` draws ω_i, :meth:`pdf` is its density.
+
+    Both take broadcastable arrays (wo (..., 3), u (..., 2), wi (..., 3))
+    that are already validated; ``sample`` returns ω_i of the broadcast
+    shape, ``pdf`` the solid-angle density over the whole sphere (it does not
+    test whether ω_o is above the horizon: :class:`StrategySampled` does).
+    """
+
+    def sample(self, wo: np.ndarray, u: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def pdf(self, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+
+class Cosine(Strategy):
+    """cos θ_i/π on the upper hemisphere (Malley's method), independent of ω_o."""
+
+    def sample(self, wo, u):
+        return np.broadcast_to(sample_cosine_hemisphere(u), (*_shape(wo, u), 3))
+
+    def pdf(self, wi, wo):
+        return pdf_cosine_hemisphere(wi)
+
+    def __repr__(self) -> str:
+        return "Cosine()"
+
+
+#: The cosine strategy (stateless; shared).
+COSINE = Cosine()
+
+
+class CosPowerNormal(Strategy):
+    """(q+1)/(2π) cos^q θ_i on the upper hemisphere (q > −1): cos θ_i = u₀^{1/(q+1)}.
+
+    The inverse CDF of cos^q θ sin θ, sampled in the local frame directly (the
+    axis is the normal). Exact for f cos θ_i ∝ cos^q θ_i (Minnaert) and a
+    dominating density for the Neumann–Neumann lacquer.
+    """
+
+    def __init__(self, q: float):
+        self.q = float(q)
+
+    def sample(self, wo, u):
+        cos_t = u[..., 0] ** (1.0 / (self.q + 1.0))
+        sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))  # clamp: rounding at cos_t = 1
+        phi = 2.0 * np.pi * u[..., 1]
+        wi = stack(sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t)
+        return np.broadcast_to(wi, np.broadcast_shapes(wi.shape, wo.shape))
+
+    def pdf(self, wi, wo):
+        c = wi[..., 2]
+        with np.errstate(divide="ignore"):
+            p = (self.q + 1.0) / (2.0 * np.pi) * np.where(c > 0.0, c, 1.0) ** self.q
+        return np.where(c > 0.0, p, 0.0)
+
+    def __repr__(self) -> str:
+        return f"CosPowerNormal({self.q:g})"
+
+
+class CosPowerAxis(Strategy):
+    """(n+1)/(2π) max(0, cos α)ⁿ about ``axis(wo)`` (:func:`sample_phong_lobe`).
+
+    Parameters
+    ----------
+    n : float
+        Exponent (> 0; use :func:`phong_lobe`, which gives the cosine for 0).
+    axis : callable, optional
+        ω_o (..., 3) → unit axis (..., 3); default: the mirror direction of ω_o
+        (the Phong lobe, a function of R·V).
+    """
+
+    def __init__(self, n: float, axis: Callable[[np.ndarray], np.ndarray] | None = None):
+        self.n = float(n)
+        self.axis = axis
+
+    def _axis(self, wo):
+        return reflect(wo) if self.axis is None else self.axis(wo)
+
+    def sample(self, wo, u):
+        shape = (*_shape(wo, u), 3)
+        return np.broadcast_to(
+            sample_phong_lobe(np.broadcast_to(self._axis(wo), shape), self.n, u), shape)
+
+    def pdf(self, wi, wo):
+        return pdf_phong_lobe(np.sum(wi * self._axis(wo), axis=-1), self.n)
+
+    def __repr__(self) -> str:
+        return f"CosPowerAxis({self.n:g}{'' if self.axis is None else ', axis=...'})"
+
+
+class HalfVectorDistribution:
+    """A density p_h of half vectors (microfacet normals) about the normal.
+
+    ``sample_h(u)`` returns unit vectors h (..., 3) in the upper hemisphere;
+    ``pdf_h(cos_h)`` is their solid-angle density as a function of cos θ_h
+    (0 for cos θ_h ≤ 0).
+    """
+
+    def sample_h(self, u: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def pdf_h(self, cos_h: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+
+class PowerHalf(HalfVectorDistribution):
+    """(n+1)/(2π) cosⁿθ_h: the Blinn (N·H)ⁿ lobe and Lewis's D₁; cos θ_h = u₀^{1/(n+1)}."""
+
+    def __init__(self, n: float):
+        self.n = float(n)
+
+    def sample_h(self, u):
+        return sample_phong_lobe(_NORMAL, self.n, u)
+
+    def pdf_h(self, cos_h):
+        return pdf_phong_lobe(cos_h, self.n)
+
+    def __repr__(self) -> str:
+        return f"PowerHalf({self.n:g})"
+
+
+class BeckmannHalf(HalfVectorDistribution):
+    """D(h) cos θ_h for Beckmann's D: exp(−tan²θ_h/m²)/(π m² cos³θ_h).
+
+    tan²θ_h = −m² ln(1 − u₀) (Walter et al. eq. 28; Ward's half-vector
+    sampling as corrected by Walter 2005).
+    """
+
+    def __init__(self, m: float):
+        self.m = float(m)
+
+    def sample_h(self, u):
+        u0 = np.minimum(u[..., 0], 1.0 - 1e-16)  # clamp: u₀ = 1 maps to θ_h = 90°
+        cos_h = 1.0 / np.sqrt(1.0 - self.m * self.m * np.log1p(-u0))
+        return _about_normal(cos_h, u)
+
+    def pdf_h(self, cos_h):
+        # clamp: avoid 0-division where the density is 0 anyway (1e-100: c⁴ must not underflow)
+        c = np.clip(cos_h, 1e-100, 1.0)
+        c2 = c * c
+        with np.errstate(under="ignore"):
+            p = np.exp(-(1.0 - c2) / c2 / self.m**2) / (np.pi * self.m**2 * c2 * c)
+        return np.where(cos_h > 0.0, p, 0.0)
+
+    def __repr__(self) -> str:
+        return f"BeckmannHalf({self.m:g})"
+
+
+class GGXHalf(HalfVectorDistribution):
+    """D(h) cos θ_h for GGX (Trowbridge–Reitz): α²/(π cos³θ_h (α² + tan²θ_h)²).
+
+    tan²θ_h = α² u₀/(1 − u₀) (Walter et al. eq. 35).
+    """
+
+    def __init__(self, alpha: float):
+        self.alpha = float(alpha)
+
+    def sample_h(self, u):
+        u0 = np.minimum(u[..., 0], 1.0 - 1e-16)  # clamp: u₀ = 1 maps to θ_h = 90°
+        cos_h = 1.0 / np.sqrt(1.0 + self.alpha * self.alpha * u0 / (1.0 - u0))
+        return _about_normal(cos_h, u)
+
+    def pdf_h(self, cos_h):
+        c = np.clip(cos_h, 1e-100, 1.0)  # clamp: as in BeckmannHalf
+        c2 = c * c
+        t = self.alpha**2 * c2 + (1.0 - c2)
+        return np.where(cos_h > 0.0, self.alpha**2 * c / (np.pi * t * t), 0.0)
+
+    def __repr__(self) -> str:
+        return f"GGXHalf({self.alpha:g})"
+
+
+def _about_normal(cos_h: np.ndarray, u: np.ndarray) -> np.ndarray:
+    sin_h = np.sqrt(np.maximum(0.0, 1.0 - cos_h * cos_h))  # clamp: rounding at cos_h = 1
+    phi = 2.0 * np.pi * u[..., 1]
+    return stack(sin_h * np.cos(phi), sin_h * np.sin(phi), cos_h)
+
+
+class HalfVector(Strategy):
+    """ω_i = 2(ω_o·h)h − ω_o with h drawn from *distribution*; density p_h(h)/(4|ω_o·h|).
+
+    Where ω_o·h < 0 the direction lands below the horizon (the BRDF is 0
+    there). ``fold`` chooses how :meth:`pdf` reads such directions back:
+    True (default) takes the upper one of ±(ω_i + ω_o)/|ω_i + ω_o| as h, so
+    the density is exact over the whole sphere; False takes
+    (ω_i + ω_o)/|ω_i + ω_o| as it is, so directions reached with ω_o·h < 0
+    get density 0 (they are then discarded like any other pdf-0 sample —
+    the convention of the microfacet samplers).
+    """
+
+    def __init__(self, distribution: HalfVectorDistribution, *, fold: bool = True):
+        self.distribution = distribution
+        self.fold = bool(fold)
+
+    def sample(self, wo, u):
+        h = self.distribution.sample_h(u)
+        h = np.broadcast_to(h, np.broadcast_shapes(h.shape, wo.shape))
+        return 2.0 * np.sum(wo * h, axis=-1, keepdims=True) * h - wo
+
+    def pdf(self, wi, wo):
+        h = wi + wo
+        norm = np.linalg.norm(h, axis=-1)
+        ok = norm > 0.0
+        h = h / np.where(ok, norm, 1.0)[..., None]
+        if self.fold:
+            # the sampled h is in the upper hemisphere; wi + wo is ±h, so take the upper one
+            h = np.where(h[..., 2:3] < 0.0, -h, h)
+        cos_oh = np.abs(np.sum(wo * h, axis=-1))
+        ok &= cos_oh > 0.0
+        p = self.distribution.pdf_h(h[..., 2]) / (4.0 * np.where(ok, cos_oh, 1.0))
+        return np.where(ok, p, 0.0)
+
+    def __repr__(self) -> str:
+        return f"HalfVector({self.distribution!r}{'' if self.fold else ', fold=False'})"
+
+
+class Mixture(Strategy):
+    """Σ_k w_k p_k: component k drawn with probability w_k.
+
+    Parameters
+    ----------
+    components : sequence of Strategy
+    weights : array_like, shape (K,) or (..., K)
+        Non-negative, summing to 1 (per ω_o when they depend on it: the
+        leading axes broadcast against ω_o's). A zero-weight component is
+        never drawn.
+    """
+
+    def __init__(self, components: Sequence[Strategy], weights):
+        self.components = list(components)
+        self.weights = np.asarray(weights, dtype=np.float64)
+        if self.weights.shape[-1:] != (len(self.components),):
+            raise ValueError(f"{len(self.components)} components but weights of shape "
+                             f"{self.weights.shape}")
+
+    def sample(self, wo, u):
+        comps = self.components
+        shape = _shape(wo, u)
+        wo = np.broadcast_to(wo, (*shape, 3))
+        u = np.broadcast_to(u, (*shape, 2))
+        w = np.broadcast_to(self.weights, (*shape, len(comps)))
+        cum = np.cumsum(w, axis=-1)
+        u0 = u[..., 0]
+        k = np.minimum(np.sum(cum <= u0[..., None], axis=-1), len(comps) - 1)
+        # never pick a zero-weight component (u₀ = 1 or rounding in the cumulative sum)
+        k = np.where(np.take_along_axis(w, k[..., None], -1)[..., 0] > 0.0, k,
+                     np.argmax(w, axis=-1))
+        lo = np.take_along_axis(cum - w, k[..., None], -1)[..., 0]
+        wk = np.take_along_axis(w, k[..., None], -1)[..., 0]
+        # rescale u₀ within the picked component's interval (clip: rounding)
+        u0r = np.clip((u0 - lo) / np.where(wk > 0.0, wk, 1.0), 0.0, 1.0)
+        ur = np.stack([u0r, u[..., 1]], axis=-1)
+        wi = np.empty((*shape, 3))
+        for j, comp in enumerate(comps):
+            sel = k == j
+            if np.any(sel):
+                wi[sel] = np.broadcast_to(comp.sample(wo, ur), (*shape, 3))[sel]
+        return wi
+
+    def pdf(self, wi, wo):
+        shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
+        w = np.broadcast_to(self.weights, (*shape, len(self.components)))
+        p = np.zeros(shape)
+        for j, comp in enumerate(self.components):
+            wj = w[..., j]
+            if np.any(wj > 0.0):
+                p = p + wj * comp.pdf(wi, wo)
+        return p
+
+    def __repr__(self) -> str:
+        return f"Mixture({self.components!r}, weights of shape {self.weights.shape})"
+
+
+def phong_lobe(n: float, axis: Callable[[np.ndarray], np.ndarray] | None = None) -> Strategy:
+    """The cosⁿ lobe about ``axis(wo)`` (default: the mirror of ω_o); the cosine for n = 0.
+
+    A lobe with exponent 0 is constant over the hemisphere (0⁰ = 1), so
+    f cos θ_i ∝ cos θ_i and the cosine samples it exactly.
+    """
+    return COSINE if n == 0.0 else CosPowerAxis(n, axis)
+
+
+def blinn_lobe(n: float) -> Strategy:
+    """The (N·H)ⁿ lobe through the half vector (:class:`PowerHalf`); the cosine for n = 0."""
+    return COSINE if n == 0.0 else HalfVector(PowerHalf(n))
+
+
+# --------------------------------------------------------------------------- models
+class StrategySampled:
+    """Mixin for models sampled by a :class:`Strategy` (put it before ``BRDF``).
+
+    The model defines ``_strategy(wo) -> Strategy`` (*wo* validated, shape
+    (..., 3); weights of a :class:`Mixture` may depend on it). :meth:`sample`
+    and :meth:`pdf` follow the :class:`~brdfkit.models.BRDF` contract.
+    """
+
+    has_sampler = True
+
+    def _strategy(self, wo: np.ndarray) -> Strategy:
+        raise NotImplementedError
+
+    def sample(self, wo, u):
+        """Draw wi given wo from *u* ∈ [0, 1]² (..., 2); returns ``(wi, pdf)``."""
+        wo = as_directions(wo, "wo")
+        u = as_uniform(u)
+        wi = self._strategy(wo).sample(wo, u)
+        if not wi.flags.writeable:
+            wi = wi.copy()  # a broadcast view: the caller gets its own array
+        return wi, self.pdf(wi, wo)
+
+    def pdf(self, wi, wo):
+        """Solid-angle density of :meth:`sample`; 0 when wo is below the horizon."""
+        wi = as_directions(wi, "wi")
+        wo = as_directions(wo, "wo")
+        p = self._strategy(wo).pdf(wi, wo)
+        return np.where(wo[..., 2] > 0.0, p, 0.0)
+
+
+def log_mixture_weights(logw: Sequence[np.ndarray]) -> np.ndarray:
+    """Per-ω_o mixture weights from their logarithms (..., K), normalised without overflow.
+
+    Where every weight is 0 (all logs −inf) the first component gets weight 1.
+    """
+    logw = np.stack(list(logw), axis=-1)
+    top = np.max(logw, axis=-1, keepdims=True)
+    none = ~np.isfinite(top)
+    with np.errstate(invalid="ignore"):
+        w = np.exp(logw - np.where(none, 0.0, top))
+    w = np.where(none, np.eye(logw.shape[-1])[0], w)
+    return w / np.sum(w, axis=-1, keepdims=True)
+
