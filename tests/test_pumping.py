@@ -113,6 +113,24 @@ def test_pumped_is_a_model(phong, phong_max):
     np.testing.assert_array_equal(from_dict(d).eval(wi, wo), phong_max[2].eval(wi, wo))
 
 
+
+def test_pumped_through_the_derived_constructor(phong, phong_max, blinn_ctrl):
+    """PumpedBRDF is built by the one constructor path of derived models (the shared
+    set-up validated the root's values and packed the rows) and declares the protocol."""
+    from brdfkit.models import DerivedBRDF
+
+    p2 = phong_max[2]
+    assert isinstance(p2, DerivedBRDF)
+    assert p2.name == "modified-phong+pump[max,max]" and p2.params == phong.params
+    assert p2.n_channels is None and p2.has_sampler == phong.has_sampler
+    assert p2.width_param == phong.width_param and p2.kernel is not None
+    assert p2.describe()["name"] == p2.name and p2.describe()["reciprocal"]
+    assert p2.isotropic and p2.albedo_kinks == phong.albedo_kinks
+    assert phong.albedo_kinks_nv(np.radians([30.0])) is None  # the base declares none
+    kv = p2.albedo_kinks_nv(np.radians([30.0, 60.0]))
+    assert kv.shape[0] == 2 and np.all(np.isfinite(kv[:, 0]))
+    assert len(blinn_ctrl[1].albedo_kink_mus) >= 1  # g2: where a(L) crosses cos θ_L
+
 def test_with_params_repumps(phong_max):
     q = phong_max[1].with_params(n=50.0)
     assert isinstance(q, PumpedBRDF) and q.stages == ["max"]
@@ -294,7 +312,7 @@ def test_lookup_kernel_matches_numpy_and_is_memory_safe():
     outside it (unnormalised or NaN cosines never index outside the table)."""
     import numba
 
-    from brdfkit.pumping import _lookup
+    from brdfkit.tables import _lookup
 
     lk = build_lookup(_kinked, kinks=KINKS)
     p = np.concatenate([[7.0, 8.0], lk.packed(0)])  # the lookup at an offset, as in a row
@@ -576,6 +594,23 @@ def test_bad_input(phong):
         pump(lambda wi, wo: 1.0, "max")
     assert pump(phong, "max", times=0) is phong
 
+
+
+def test_times_bounded(phong, phong_max):
+    """times is bounded by MAX_TIMES (each stage tabulates the previous one's albedo with
+    the engine: 8 stages take about a minute, 16 did not finish in 9); the stages the
+    model already has count; nothing is built before the check."""
+    from brdfkit.pumping import MAX_TIMES
+
+    assert MAX_TIMES == 8
+    with pytest.raises(ParameterError, match=r"times must be at most MAX_TIMES = 8 .*"
+                                             r"got times = 100"):
+        pump(phong, "controlled", times=100)
+    with pytest.raises(ParameterError, match=r"MAX_TIMES = 8 .*already has 1 stage\).*"
+                                             r"got times = 8"):
+        pump(phong_max[1], "max", times=MAX_TIMES)
+    with pytest.raises(ParameterError, match=r"pump_sequence: times .*MAX_TIMES = 8"):
+        pump_sequence(phong, "max", times=9)
 
 def test_cli_pump(phong):
     import json
