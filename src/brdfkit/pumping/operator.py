@@ -28,7 +28,7 @@ from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models._base import BRDF, DerivedBRDF
 from brdfkit.pumping.kernels import G_NUMPY, chain_kernel, stage_kernel
 from brdfkit.pumping.table import ENGINE_ERR, _crossings, _dips, build_albedo_table
-from brdfkit.tables import _as_2d, build_lookup
+from brdfkit.tables import _as_2d, build_lookup, mu_of_w
 
 __all__ = [
     "CHAIN_DIP_TOL",
@@ -237,7 +237,7 @@ class PumpedBRDF(DerivedBRDF):
         lookup of an unchained stage, capped in its kernel), where it reaches the
         cap 1 and (g₂) where it crosses μ."""
         w = self.table.breaks[:-1]
-        out = [1.0 - (1.0 - w * w) ** 2]
+        out = [mu_of_w(w)]
         if table_only:
             return out[0]
         dip = float(self._dip[c])

@@ -24,7 +24,7 @@ import numpy as np
 
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models._base import BRDF
-from brdfkit.tables import _as_2d
+from brdfkit.tables import _as_2d, mu_of_w, theta_of_w, w_of_mu
 
 __all__ = ["ENGINE_ERR", "ENGINE_TOL", "INTERP_TOL", "THETA_TOP", "AlbedoTable",
            "build_albedo_table"]
@@ -64,8 +64,8 @@ class AlbedoTable:
     piece_nn : tuple of int
         Intervals of each piece.
     s_top : float
-        w(THETA_TOP): the grid is uniform in w = √(1 − √(1 − cos θ)) on
-        [s_top, 1]. This variable is linear in θ at normal incidence (where
+        w(THETA_TOP): the grid is uniform in w = √(1 − √(1 − cos θ)) (the
+        shared :func:`brdfkit.tables.w_of_mu`) on [s_top, 1]. This variable is linear in θ at normal incidence (where
         the albedo is even in θ, so the spline is clamped to zero slope there)
         and its square is linear in cos θ at grazing (cos θ = 2w² − w⁴), so
         the nodes crowd where sharp lobes meet the horizon.
@@ -109,7 +109,7 @@ class AlbedoTable:
     def at_cos(self, mu) -> np.ndarray:
         """Tabulated albedo at cos θ = *mu* (NumPy; kernels read a :class:`Lookup` of it)."""
         mu = np.asarray(mu, dtype=np.float64)
-        w = _w_of_mu(mu)
+        w = w_of_mu(mu)
         nns = np.array(self.piece_nn)
         i = np.clip(np.searchsorted(self.breaks[1:-1], w, side="right"), 0, nns.size - 1)
         start = self.breaks[i]
@@ -172,10 +172,10 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
     if not (isinstance(tol, float | int) and 0.0 < tol < 1.0):
         raise ParameterError(f"build_albedo_table: tol must lie in (0, 1); got {tol!r}")
     run = _engine(model)
-    s_top = float(_w_of_mu(math.cos(THETA_TOP)))
+    s_top = float(w_of_mu(math.cos(THETA_TOP)))
     if kinks_mu is None:
         kinks_mu = model.albedo_kink_mus
-    kw = np.sort(_w_of_mu(np.asarray(kinks_mu, dtype=np.float64).reshape(-1)))
+    kw = np.sort(w_of_mu(np.asarray(kinks_mu, dtype=np.float64).reshape(-1)))
     breaks = [s_top]
     for x in kw:  # pieces at least 1e-3 wide in w (closer kinks: one piece, refined)
         if x - breaks[-1] > 1e-3 and 1.0 - x > 1e-3:
@@ -183,19 +183,16 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
     breaks.append(1.0)
     breaks = np.array(breaks)
 
-    def thetas(w):
-        return np.arccos(np.clip(1.0 - (1.0 - w * w) ** 2, 0.0, 1.0))
-
     n_eval = 0
     all_coeffs, all_nodes, piece_nn, max_errs, maxes = [], [], [], [], []
     for lo, hi in zip(breaks[:-1], breaks[1:], strict=True):
         nn = max(4, int(round(nn_start * (hi - lo) / (1.0 - s_top))))
         s_nodes = np.linspace(lo, hi, nn + 1)
-        vals = _as_2d(run(thetas(s_nodes)))
+        vals = _as_2d(run(theta_of_w(s_nodes)))
         n_eval += len(s_nodes)
         while True:
             s_mid = 0.5 * (s_nodes[:-1] + s_nodes[1:])
-            mid = _as_2d(run(thetas(s_mid)))
+            mid = _as_2d(run(theta_of_w(s_mid)))
             n_eval += len(s_mid)
             if not (np.all(np.isfinite(vals)) and np.all(np.isfinite(mid))):
                 raise BrdfkitError(f"pumping: the albedo of {model.name} is not finite on "
@@ -210,7 +207,7 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
                 raise BrdfkitError(
                     f"pumping: could not tabulate the albedo of {model.name} to {tol:g} "
                     f"with {nn_max} intervals (error {err.max():.3g} at theta = "
-                    f"{math.degrees(thetas(s_mid[worst])):.4f} deg)")
+                    f"{math.degrees(theta_of_w(s_mid[worst])):.4f} deg)")
             # the midpoints become nodes of the doubled grid
             merged = np.empty((2 * nn + 1, vals.shape[1]))
             merged[0::2] = vals
@@ -231,14 +228,8 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
     return AlbedoTable(coeffs=coeffs, s_top=s_top, breaks=breaks, piece_nn=tuple(piece_nn),
                        max_midpoint_error=max_err, delta=delta,
                        max_albedo=np.max(maxes, axis=0),
-                       theta_nodes=thetas(np.concatenate(all_nodes)), n_evaluations=n_eval,
+                       theta_nodes=theta_of_w(np.concatenate(all_nodes)), n_evaluations=n_eval,
                        coloured=coloured)
-
-
-def _w_of_mu(mu) -> np.ndarray:
-    """Table variable w = √(1 − √(1 − μ)) of μ = cos θ (clamped to [0, 1])."""
-    r = np.clip(1.0 - np.asarray(mu, dtype=np.float64), 0.0, 1.0)
-    return np.sqrt(1.0 - np.sqrt(r))
 
 
 def _crossings(fn: Callable, grid: np.ndarray, values: np.ndarray) -> np.ndarray:
@@ -259,7 +250,7 @@ def _dips(albedo_at_cos: Callable, n: int = 1 << 15) -> np.ndarray:
     cos θ grows (0 for a non-decreasing one), on a grid dense at grazing like the
     table's variable."""
     w = np.linspace(0.0, 1.0, n)
-    a = _as_2d(albedo_at_cos(1.0 - (1.0 - w * w) ** 2))
+    a = _as_2d(albedo_at_cos(mu_of_w(w)))
     return np.max(np.maximum.accumulate(a, axis=0) - a, axis=0)
 
 
