@@ -36,7 +36,6 @@ from brdfkit.pumping import (
     LUT_TOL,
     PumpedBRDF,
     PumpingWarning,
-    build_lookup,
     from_dict,
     mirror_radiance,
     pump,
@@ -275,59 +274,6 @@ def test_table_split_at_kinks(blinn_ctrl):
     # the stage-2 and stage-3 tables are split at the kink near 85.9° (a₀ = cos θ)
     assert len(blinn_ctrl[2].table.piece_nn) >= 2
     assert blinn_ctrl[3].table.n_intervals < 200
-
-
-# --------------------------------------------------------------------------- evaluation lookup
-KINKS = [0.3, 0.3051]  # two kinks in one first-level cell ([19/64, 20/64))
-
-
-def _kinked(mu):
-    # closed form with kinks at KINKS (slope jumps 2 and 1) and a sharp rise near grazing
-    mu = np.asarray(mu, dtype=float)
-    return (1.0 + np.abs(mu - KINKS[0]) + 0.5 * np.abs(mu - KINKS[1])
-            + 0.5 * np.exp(-mu / 0.01))[:, None]
-
-
-@pytest.mark.parametrize("bound", ["upper", "lower"])
-def test_lookup_accuracy_bound_and_kink_anchoring(bound):
-    """Lookup vs a closed form at 2e5 random points: within 3 LUT_TOL, on the requested side;
-    declared kinks are grid nodes (no refinement), undeclared ones cost intervals."""
-    lk = build_lookup(_kinked, kinks=KINKS, bound=bound)
-    mu = np.random.default_rng(1).uniform(0.0, 1.0, 200_000)
-    exact = _kinked(mu)[:, 0]
-    got = lk(mu)[:, 0]
-    rel = (got - exact) / exact
-    assert np.max(np.abs(rel)) <= 3 * LUT_TOL
-    # from the requested side, up to rounding (the margin is verified at check points only)
-    assert (np.min(rel) >= -1e-12) if bound == "upper" else (np.max(rel) <= 1e-12)
-    exact_k = _kinked(np.array(KINKS))[:, 0]
-    assert np.all(np.abs(lk(np.array(KINKS))[:, 0] / exact_k - 1.0) <= 3 * LUT_TOL)
-    blind = build_lookup(_kinked, kinks=[], bound=bound)
-    assert lk.n_intervals < blind.n_intervals / 2
-    assert blind.max_error > 0.0 and lk.epsilon <= 2 * max(lk.max_error, 1e-15) + 1e-14
-
-
-def test_lookup_kernel_matches_numpy_and_is_memory_safe():
-    """The compiled _lookup and Lookup.__call__ agree bit for bit on [0, 1], and clamp
-    outside it (unnormalised or NaN cosines never index outside the table)."""
-    import numba
-
-    from brdfkit.tables import _lookup
-
-    lk = build_lookup(_kinked, kinks=KINKS)
-    p = np.concatenate([[7.0, 8.0], lk.packed(0)])  # the lookup at an offset, as in a row
-
-    @numba.njit
-    def run(p, mus):
-        out = np.empty(mus.size)
-        for i in range(mus.size):
-            out[i] = _lookup(p, 2, mus[i])
-        return out
-
-    mu = np.r_[np.linspace(0.0, 1.0, 10_001), np.nextafter(1.0, 2.0)]
-    np.testing.assert_array_equal(run(p, mu), lk(mu)[:, 0])
-    edge = run(p, np.array([1.0, 1.5, 1e300, -0.5, np.nan]))
-    assert edge[1] == edge[2] == edge[0] and edge[3] == edge[4] == run(p, np.array([0.0]))[0]
 
 
 def test_own_driver_matches_generic_loop_and_rejects_nan(phong_max):
