@@ -2,7 +2,7 @@
 
 Reference values come from: the definition f* = f/g (eqs. 16, 20, 21) with
 albedos from the albedo engine (independent of the pumping tables); the
-derived theorem a ≤ a* ≤ 1 (eqs. 17–19, re-derived in brdfkit.pumping);
+derived theorem a ≤ a* ≤ 1 (eqs. 17–19, re-derived in docs/pumping.md);
 closed forms (a*(0) = 1 for g₁ when the albedo peaks at normal incidence;
 the Phong identity a(θ) ≥ cos θ); brute-force Gauss–Legendre quadrature; and
 the paper's qualitative statements (§3.1, §3.2), quantified.
@@ -392,7 +392,7 @@ def test_theorem_registry(name, params, g):
     if p.capped:
         assert np.all(a1 >= a - 1e-6), a1 - a
         assert not any(issubclass(w.category, PumpingWarning) for w in rec)
-    else:  # the base gains energy somewhere: eq. 17 cannot hold (see brdfkit.pumping)
+    else:  # the base gains energy somewhere: eq. 17 cannot hold (see docs/pumping.md)
         assert np.max(p.table.max_albedo) > 1.0
         assert any(issubclass(w.category, PumpingWarning) for w in rec)
 

@@ -107,9 +107,9 @@ class PumpedBRDF(DerivedBRDF):
         ``len(stages)``.
     chained : bool
         Whether this stage and all below it have non-decreasing albedos, so
-        the kernel is f_root · q(max(N·L, N·V)) with one lookup (module
-        ``docs/pumping.md``, "Evaluation"); otherwise the kernel wraps the base's
-        with two lookups of this stage's albedo.
+        the kernel is f_root · q(max(N·L, N·V)) with one lookup
+        (``docs/pumping.md``, "Evaluation"); otherwise the kernel wraps the
+        base's with two lookups of this stage's albedo.
     lookups : tuple of Lookup
         Per channel: q of the chain (``chained``) or this stage's capped
         albedo; empty for a custom g (evaluated in NumPy from ``table``).

@@ -65,10 +65,11 @@ class AlbedoTable:
         Intervals of each piece.
     s_top : float
         w(THETA_TOP): the grid is uniform in w = √(1 − √(1 − cos θ)) (the
-        shared :func:`brdfkit.tables.w_of_mu`) on [s_top, 1]. This variable is linear in θ at normal incidence (where
-        the albedo is even in θ, so the spline is clamped to zero slope there)
-        and its square is linear in cos θ at grazing (cos θ = 2w² − w⁴), so
-        the nodes crowd where sharp lobes meet the horizon.
+        shared :func:`brdfkit.tables.w_of_mu`) on [s_top, 1]. This variable is
+        linear in θ at normal incidence (where the albedo is even in θ, so the
+        spline is clamped to zero slope there) and its square is linear in
+        cos θ at grazing (cos θ = 2w² − w⁴), so the nodes crowd where sharp
+        lobes meet the horizon.
     max_midpoint_error : ndarray, shape (C,)
         Largest |spline − engine| over the interval midpoints.
     delta : ndarray, shape (C,)
