@@ -2,7 +2,7 @@
 
 Reference values come from: the definition f* = f/g (eqs. 16, 20, 21) with
 albedos from the albedo engine (independent of the pumping tables); the
-derived theorem a ≤ a* ≤ 1 (eqs. 17–19, re-derived in brdfkit.pumping);
+derived theorem a ≤ a* ≤ 1 (eqs. 17–19, re-derived in docs/pumping.md);
 closed forms (a*(0) = 1 for g₁ when the albedo peaks at normal incidence;
 the Phong identity a(θ) ≥ cos θ); brute-force Gauss–Legendre quadrature; and
 the paper's qualitative statements (§3.1, §3.2), quantified.
@@ -36,7 +36,6 @@ from brdfkit.pumping import (
     LUT_TOL,
     PumpedBRDF,
     PumpingWarning,
-    build_lookup,
     from_dict,
     mirror_radiance,
     pump,
@@ -112,6 +111,24 @@ def test_pumped_is_a_model(phong, phong_max):
     wi, wo = _random_pairs(50, 1)
     np.testing.assert_array_equal(from_dict(d).eval(wi, wo), phong_max[2].eval(wi, wo))
 
+
+
+def test_pumped_through_the_derived_constructor(phong, phong_max, blinn_ctrl):
+    """PumpedBRDF is built by the one constructor path of derived models (the shared
+    set-up validated the root's values and packed the rows) and declares the protocol."""
+    from brdfkit.models import DerivedBRDF
+
+    p2 = phong_max[2]
+    assert isinstance(p2, DerivedBRDF)
+    assert p2.name == "modified-phong+pump[max,max]" and p2.params == phong.params
+    assert p2.n_channels is None and p2.has_sampler == phong.has_sampler
+    assert p2.width_param == phong.width_param and p2.kernel is not None
+    assert p2.describe()["name"] == p2.name and p2.describe()["reciprocal"]
+    assert p2.isotropic and p2.albedo_kinks == phong.albedo_kinks
+    assert phong.albedo_kinks_nv(np.radians([30.0])) is None  # the base declares none
+    kv = p2.albedo_kinks_nv(np.radians([30.0, 60.0]))
+    assert kv.shape[0] == 2 and np.all(np.isfinite(kv[:, 0]))
+    assert len(blinn_ctrl[1].albedo_kink_mus) >= 1  # g2: where a(L) crosses cos θ_L
 
 def test_with_params_repumps(phong_max):
     q = phong_max[1].with_params(n=50.0)
@@ -259,59 +276,6 @@ def test_table_split_at_kinks(blinn_ctrl):
     assert blinn_ctrl[3].table.n_intervals < 200
 
 
-# --------------------------------------------------------------------------- evaluation lookup
-KINKS = [0.3, 0.3051]  # two kinks in one first-level cell ([19/64, 20/64))
-
-
-def _kinked(mu):
-    # closed form with kinks at KINKS (slope jumps 2 and 1) and a sharp rise near grazing
-    mu = np.asarray(mu, dtype=float)
-    return (1.0 + np.abs(mu - KINKS[0]) + 0.5 * np.abs(mu - KINKS[1])
-            + 0.5 * np.exp(-mu / 0.01))[:, None]
-
-
-@pytest.mark.parametrize("bound", ["upper", "lower"])
-def test_lookup_accuracy_bound_and_kink_anchoring(bound):
-    """Lookup vs a closed form at 2e5 random points: within 3 LUT_TOL, on the requested side;
-    declared kinks are grid nodes (no refinement), undeclared ones cost intervals."""
-    lk = build_lookup(_kinked, kinks=KINKS, bound=bound)
-    mu = np.random.default_rng(1).uniform(0.0, 1.0, 200_000)
-    exact = _kinked(mu)[:, 0]
-    got = lk(mu)[:, 0]
-    rel = (got - exact) / exact
-    assert np.max(np.abs(rel)) <= 3 * LUT_TOL
-    # from the requested side, up to rounding (the margin is verified at check points only)
-    assert (np.min(rel) >= -1e-12) if bound == "upper" else (np.max(rel) <= 1e-12)
-    exact_k = _kinked(np.array(KINKS))[:, 0]
-    assert np.all(np.abs(lk(np.array(KINKS))[:, 0] / exact_k - 1.0) <= 3 * LUT_TOL)
-    blind = build_lookup(_kinked, kinks=[], bound=bound)
-    assert lk.n_intervals < blind.n_intervals / 2
-    assert blind.max_error > 0.0 and lk.epsilon <= 2 * max(lk.max_error, 1e-15) + 1e-14
-
-
-def test_lookup_kernel_matches_numpy_and_is_memory_safe():
-    """The compiled _lookup and Lookup.__call__ agree bit for bit on [0, 1], and clamp
-    outside it (unnormalised or NaN cosines never index outside the table)."""
-    import numba
-
-    from brdfkit.pumping import _lookup
-
-    lk = build_lookup(_kinked, kinks=KINKS)
-    p = np.concatenate([[7.0, 8.0], lk.packed(0)])  # the lookup at an offset, as in a row
-
-    @numba.njit
-    def run(p, mus):
-        out = np.empty(mus.size)
-        for i in range(mus.size):
-            out[i] = _lookup(p, 2, mus[i])
-        return out
-
-    mu = np.r_[np.linspace(0.0, 1.0, 10_001), np.nextafter(1.0, 2.0)]
-    np.testing.assert_array_equal(run(p, mu), lk(mu)[:, 0])
-    edge = run(p, np.array([1.0, 1.5, 1e300, -0.5, np.nan]))
-    assert edge[1] == edge[2] == edge[0] and edge[3] == edge[4] == run(p, np.array([0.0]))[0]
-
-
 def test_own_driver_matches_generic_loop_and_rejects_nan(phong_max):
     """A pumped model evaluates through its own compiled loop (checked_driver, the kernel
     inlined); it must give what the generic first-class-function loop gives, and report
@@ -428,7 +392,7 @@ def test_theorem_registry(name, params, g):
     if p.capped:
         assert np.all(a1 >= a - 1e-6), a1 - a
         assert not any(issubclass(w.category, PumpingWarning) for w in rec)
-    else:  # the base gains energy somewhere: eq. 17 cannot hold (see brdfkit.pumping)
+    else:  # the base gains energy somewhere: eq. 17 cannot hold (see docs/pumping.md)
         assert np.max(p.table.max_albedo) > 1.0
         assert any(issubclass(w.category, PumpingWarning) for w in rec)
 
@@ -576,6 +540,23 @@ def test_bad_input(phong):
         pump(lambda wi, wo: 1.0, "max")
     assert pump(phong, "max", times=0) is phong
 
+
+
+def test_times_bounded(phong, phong_max):
+    """times is bounded by MAX_TIMES (each stage tabulates the previous one's albedo with
+    the engine: 8 stages take about a minute, 16 did not finish in 9); the stages the
+    model already has count; nothing is built before the check."""
+    from brdfkit.pumping import MAX_TIMES
+
+    assert MAX_TIMES == 8
+    with pytest.raises(ParameterError, match=r"times must be at most MAX_TIMES = 8 .*"
+                                             r"got times = 100"):
+        pump(phong, "controlled", times=100)
+    with pytest.raises(ParameterError, match=r"MAX_TIMES = 8 .*already has 1 stage\).*"
+                                             r"got times = 8"):
+        pump(phong_max[1], "max", times=MAX_TIMES)
+    with pytest.raises(ParameterError, match=r"pump_sequence: times .*MAX_TIMES = 8"):
+        pump_sequence(phong, "max", times=9)
 
 def test_cli_pump(phong):
     import json

@@ -681,7 +681,7 @@ def H_s(theta_i, n: float, *, lobe: str = "phong", tol: float = 1e-8) -> AlbedoR
     n = float(n)
     if not (n >= 0.0 and math.isfinite(n)):
         raise ParameterError(f"n must be a finite number >= 0; got {n!r}")
-    th = _check_theta(theta_i)
+    th = check_theta(theta_i)
     _check_tol(tol)
     value, error = specular_integral_with_error(th, n, lobe)
     return AlbedoResult(theta=th.copy(), albedo=value, error=error)
