@@ -39,7 +39,7 @@ from brdfkit.cli.model_commands import eval_cmd, models_cmd
 __all__ = ["main"]
 
 
-@click.group(cls=BrdfkitGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.group("brdfkit", cls=BrdfkitGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(brdfkit.__version__, prog_name="brdfkit")
 def main() -> None:
     """brdfkit: physically plausible reflectance models (BRDFs).

@@ -50,7 +50,7 @@ __all__ = [
 #: 9 minutes). MUST equal ``brdfkit.pumping.MAX_TIMES`` (tests/test_cli_inputs.py checks).
 PUMP_MAX_TIMES = 8
 _TIMES_REASON = ("each pumping tabulates the previous stage's albedo, so the cost grows with "
-                 "the number of stages (times=8 takes about a minute)")
+                 "the number of stages: times=8 takes about a minute")
 
 #: Largest polar angle of a command-line direction, degrees. Above 90 the direction is
 #: below the horizon and every BRDF is 0 there (the package convention); 180 is straight
@@ -143,11 +143,12 @@ def parse_param_items(model_name: str, items: Iterable[str] | Mapping) -> dict:
     return out
 
 
-def _check_times(times: int) -> int:
+def _times_problem(times) -> str | None:
+    """Why *times* is not a valid ``--times`` (without the option name), or None."""
     if isinstance(times, bool) or int(times) != times or not 1 <= int(times) <= PUMP_MAX_TIMES:
-        raise BrdfkitError(f"--times must be an integer from 1 to {PUMP_MAX_TIMES} "
-                           f"({_TIMES_REASON}); got {times}")
-    return int(times)
+        return (f"must be an integer from 1 to {PUMP_MAX_TIMES}; got {times} "
+                f"({_TIMES_REASON})")
+    return None
 
 
 def build_model(name: str, params: Iterable[str] | Mapping = (), pump: str | None = None,
@@ -180,15 +181,18 @@ def build_model(name: str, params: Iterable[str] | Mapping = (), pump: str | Non
     m = cls(**kwargs)
     if pump is None:
         return m
-    return pump_model(m, g=pump, times=_check_times(1 if times is None else times))
+    times = 1 if times is None else times
+    problem = _times_problem(times)
+    if problem is not None:
+        raise BrdfkitError(f"--times {problem}")
+    return pump_model(m, g=pump, times=int(times))
 
 
 def _times_callback(ctx: click.Context, param: click.Parameter, value):
-    try:
-        return None if value is None else _check_times(value)
-    except BrdfkitError as exc:
-        raise click.BadParameter(str(exc).removeprefix("--times "), ctx=ctx, param=param) \
-            from None
+    problem = None if value is None else _times_problem(value)
+    if problem is not None:
+        raise click.BadParameter(problem, ctx=ctx, param=param)
+    return value
 
 
 def model_options(func: Callable) -> Callable:
@@ -201,7 +205,7 @@ def model_options(func: Callable) -> Callable:
     func = click.option("--times", type=int, default=None, callback=_times_callback,
                         metavar="K",
                         help=f"Apply the pumping K times (needs --pump; 1 to {PUMP_MAX_TIMES}, "
-                             f"default 1: {_TIMES_REASON}).")(func)
+                             f"default 1; {_TIMES_REASON}).")(func)
     func = click.option("--pump", type=click.Choice(["max", "controlled"]), default=None,
                         help="Pump up the albedo (Neumann et al. 1999, eqs. 16-21) with "
                              "g1 ('max') or g2 ('controlled').")(func)

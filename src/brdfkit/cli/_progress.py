@@ -16,6 +16,7 @@ Public objects
 from __future__ import annotations
 
 import contextlib
+import sys
 import time
 from collections.abc import Callable, Iterator
 
@@ -26,9 +27,8 @@ __all__ = ["stderr_is_interactive", "counter", "status"]
 
 def stderr_is_interactive() -> bool:
     """True when stderr is a terminal (a person is watching)."""
-    stream = click.get_text_stream("stderr")
     try:
-        return bool(stream.isatty())
+        return bool(sys.stderr.isatty())
     except (AttributeError, ValueError):  # closed or exotic streams: treat as not interactive
         return False
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 import click
 import numpy as np
 
-from brdfkit.cli import _progress
+import brdfkit.cli._progress as _progress
 from brdfkit.cli._common import build_model, emit_json, model_options
 from brdfkit.errors import BrdfkitError
 
