@@ -47,7 +47,7 @@ __all__ = [
 
 #: Largest ``--times``. Each pumping tabulates the previous stage's albedo, so the cost
 #: grows with the number of stages (times = 8 takes about a minute; 16 did not finish in
-#: 9 minutes). MUST equal ``brdfkit.pumping.MAX_TIMES`` (tests/test_cli_inputs.py checks).
+#: 9 minutes, issue 8). MUST equal ``brdfkit.pumping.MAX_TIMES`` (tests/test_cli_inputs.py checks).
 PUMP_MAX_TIMES = 8
 _TIMES_REASON = ("each pumping tabulates the previous stage's albedo, so the cost grows with "
                  "the number of stages: times=8 takes about a minute")
@@ -145,7 +145,11 @@ def parse_param_items(model_name: str, items: Iterable[str] | Mapping) -> dict:
 
 def _times_problem(times) -> str | None:
     """Why *times* is not a valid ``--times`` (without the option name), or None."""
-    if isinstance(times, bool) or int(times) != times or not 1 <= int(times) <= PUMP_MAX_TIMES:
+    try:
+        ok = not isinstance(times, bool) and int(times) == times and 1 <= times <= PUMP_MAX_TIMES
+    except (TypeError, ValueError):  # not a number at all (e.g. a string through the API)
+        ok = False
+    if not ok:
         return (f"must be an integer from 1 to {PUMP_MAX_TIMES}; got {times} "
                 f"({_TIMES_REASON})")
     return None
