@@ -28,6 +28,10 @@ __all__ = ["EXIT_USAGE", "EXIT_SIGTERM", "BrdfkitGroup", "OneLineError", "one_li
 
 #: Exit status for bad input (the same as click's usage errors).
 EXIT_USAGE = 2
+# Bare 'brdfkit' raises this in click >= 8.2 (shown as the help, exit 2); click 8.1, which
+# pyproject still allows, prints the help and exits 0 without raising, hence the fallback.
+_NO_ARGS_IS_HELP = getattr(click.exceptions, "NoArgsIsHelpError", ())
+
 #: Exit status after SIGTERM: 128 + signal number, as a shell reports a killed process.
 EXIT_SIGTERM = 128 + int(signal.SIGTERM)
 
@@ -84,7 +88,7 @@ class BrdfkitGroup(click.Group):
     def make_context(self, info_name, args, parent=None, **extra):
         try:
             return super().make_context(info_name, args, parent=parent, **extra)
-        except click.exceptions.NoArgsIsHelpError:
+        except _NO_ARGS_IS_HELP:
             raise  # bare 'brdfkit': the help is the useful answer
         except click.UsageError as exc:
             raise OneLineError(_usage_message(exc)) from exc
