@@ -31,6 +31,7 @@ References
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 import brdfkit
 from brdfkit.analysis.plausibility import check
@@ -144,13 +145,19 @@ def _row(model, label: str, lewis=None) -> dict:
     return row
 
 
-def table2(*, models=None) -> list[dict]:
+def table2(*, models=None,
+           progress: Callable[[int, int, str], None] | None = None) -> list[dict]:
     """Verdict rows: every registered model (defaults), then the extra parameterisations.
 
     Parameters
     ----------
     models : iterable of str, keyword-only, optional
         Restrict to these registered names (default: all).
+    progress : callable, keyword-only, optional
+        Called as ``progress(done, total, model_name)`` before each row is
+        computed (``done`` rows of ``total`` are finished, *model_name* is
+        the model of the row now being computed) and once at the end as
+        ``progress(total, total, "")``. It does not change the rows.
 
     Returns
     -------
@@ -161,17 +168,26 @@ def table2(*, models=None) -> list[dict]:
     names = list(brdfkit.MODELS) if models is None else [brdfkit.models.resolve(n).name
                                                          for n in models]
     lewis_by_model = {r[1]: r for r in LEWIS_ROWS}
+    extra = [(name, params, label) for name, params, label in EXTRA_ROWS if name in names]
+    total = len(names) + len(extra)
+
+    def report(done: int, name: str) -> None:
+        if progress is not None:
+            progress(done, total, name)
+
     rows = []
     for name in names:
+        report(len(rows), name)
         m = brdfkit.model(name)
         label = name
         lw = lewis_by_model.get(name)
         if lw is not None:
             label = f"{name} [Lewis: {lw[0]}]"
         rows.append(_row(m, label, lw))
-    for name, params, label in EXTRA_ROWS:
-        if name in names:
-            rows.append(_row(brdfkit.model(name, **params), f"{name} [{label}]"))
+    for name, params, label in extra:
+        report(len(rows), name)
+        rows.append(_row(brdfkit.model(name, **params), f"{name} [{label}]"))
+    report(len(rows), "")
     return rows
 
 

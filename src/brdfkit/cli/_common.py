@@ -11,40 +11,51 @@ named, parameterised and reported the same way everywhere:
   in degrees → radians).
 - :func:`build_model` — the model, optionally pumped (:mod:`brdfkit.pumping`).
 - :func:`parse_direction` — ``THETA,PHI`` in degrees → unit vector.
-- :func:`handle_errors` — turn :class:`~brdfkit.errors.BrdfkitError` into
-  ``brdfkit: error: <message>`` on stderr and exit status 2.
 - :func:`emit_json` / :func:`to_jsonable` — JSON output (NumPy → lists,
   NaN/inf → null).
+- :data:`PUMP_MAX_TIMES` — the largest ``--times``.
+
+Errors are raised as :class:`~brdfkit.errors.BrdfkitError`; the group
+(:mod:`brdfkit.cli._group`) prints them as one line, exit status 2.
 """
 
 from __future__ import annotations
 
-import functools
 import json
 import math
-import sys
 from collections.abc import Callable, Iterable, Mapping
 
 import click
 import numpy as np
 
+from brdfkit.cli._group import EXIT_USAGE
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models import resolve
+from brdfkit.pumping import pump as pump_model
 
 __all__ = [
     "EXIT_USAGE",
+    "PUMP_MAX_TIMES",
+    "THETA_MAX_DEG",
     "model_options",
     "parse_param_items",
     "build_model",
     "parse_direction",
-    "handle_errors",
-    "fail",
     "to_jsonable",
     "emit_json",
 ]
 
-#: Exit status for bad input (the same as click's usage errors).
-EXIT_USAGE = 2
+#: Largest ``--times``. Each pumping tabulates the previous stage's albedo, so the cost
+#: grows with the number of stages (times = 8 takes about a minute; 16 did not finish in
+#: 9 minutes, issue 8). MUST equal ``brdfkit.pumping.MAX_TIMES`` (tests/test_cli_inputs.py checks).
+PUMP_MAX_TIMES = 8
+_TIMES_REASON = ("each pumping tabulates the previous stage's albedo, so the cost grows with "
+                 "the number of stages: times=8 takes about a minute")
+
+#: Largest polar angle of a command-line direction, degrees. Above 90 the direction is
+#: below the horizon and every BRDF is 0 there (the package convention); 180 is straight
+#: down. Larger values would wrap around (390 = 30) and are refused instead.
+THETA_MAX_DEG = 180.0
 
 PARAM_HELP = (
     "Model parameter NAME=VALUE (repeatable). VALUE is a number, comma-separated "
@@ -53,27 +64,6 @@ PARAM_HELP = (
     "'beta' (lobe half-angle) is in DEGREES here (radians in the API). "
     "See 'brdfkit models' for each model's parameters."
 )
-
-
-# --------------------------------------------------------------------------- errors
-def fail(message: str) -> None:
-    """Print ``brdfkit: error: <message>`` (one line) on stderr and exit with status 2."""
-    one_line = " ".join(str(message).split())
-    click.echo(f"brdfkit: error: {one_line}", err=True)
-    sys.exit(EXIT_USAGE)
-
-
-def handle_errors(func: Callable) -> Callable:
-    """Decorator: a :class:`BrdfkitError` raised by *func* becomes :func:`fail`."""
-
-    @functools.wraps(func)
-    def wrapper(*args, **kwargs):
-        try:
-            return func(*args, **kwargs)
-        except BrdfkitError as exc:
-            fail(str(exc))
-
-    return wrapper
 
 
 # --------------------------------------------------------------------------- parameters
@@ -153,8 +143,20 @@ def parse_param_items(model_name: str, items: Iterable[str] | Mapping) -> dict:
     return out
 
 
+def _times_problem(times) -> str | None:
+    """Why *times* is not a valid ``--times`` (without the option name), or None."""
+    try:
+        ok = not isinstance(times, bool) and int(times) == times and 1 <= times <= PUMP_MAX_TIMES
+    except (TypeError, ValueError):  # not a number at all (e.g. a string through the API)
+        ok = False
+    if not ok:
+        return (f"must be an integer from 1 to {PUMP_MAX_TIMES}; got {times} "
+                f"({_TIMES_REASON})")
+    return None
+
+
 def build_model(name: str, params: Iterable[str] | Mapping = (), pump: str | None = None,
-                times: int = 1):
+                times: int | None = None):
     """Build model *name* from command-line parameters, pumped if asked.
 
     Parameters
@@ -165,36 +167,49 @@ def build_model(name: str, params: Iterable[str] | Mapping = (), pump: str | Non
         See :func:`parse_param_items`.
     pump : {None, "max", "controlled"}
         Apply :func:`brdfkit.pumping.pump` with this g.
-    times : int
-        How many times to pump (≥ 1; only with *pump*).
+    times : int, optional
+        How many times to pump, 1 … :data:`PUMP_MAX_TIMES` (default 1); only
+        with *pump*.
 
     Raises
     ------
     BrdfkitError
-        Unknown model, bad parameter, or pumping unavailable.
+        Unknown model, bad parameter, *times* out of range, or *times*
+        given without *pump* (it would be silently ignored).
     """
     cls = resolve(name)
     kwargs = parse_param_items(cls.name, params)
+    if pump is None and times is not None:
+        raise BrdfkitError(f"--times {times} needs --pump max or --pump controlled (it says how "
+                           "many times to pump); add --pump or drop --times")
     m = cls(**kwargs)
     if pump is None:
         return m
-    if int(times) < 1:
-        raise BrdfkitError(f"--times must be >= 1; got {times}")
-    try:
-        from brdfkit.pumping import pump as pump_model
-    except ImportError:
-        raise BrdfkitError("pumping is not available (brdfkit.pumping is missing)") from None
+    times = 1 if times is None else times
+    problem = _times_problem(times)
+    if problem is not None:
+        raise BrdfkitError(f"--times {problem}")
     return pump_model(m, g=pump, times=int(times))
+
+
+def _times_callback(ctx: click.Context, param: click.Parameter, value):
+    problem = None if value is None else _times_problem(value)
+    if problem is not None:
+        raise click.BadParameter(problem, ctx=ctx, param=param)
+    return value
 
 
 def model_options(func: Callable) -> Callable:
     """Decorator adding ``MODEL``, ``-p/--param``, ``--pump`` and ``--times`` to a command.
 
     The command receives ``model`` (str), ``param`` (tuple of str), ``pump``
-    (str or None) and ``times`` (int); pass them to :func:`build_model`.
+    (str or None) and ``times`` (int, or None when not given); pass them to
+    :func:`build_model`.
     """
-    func = click.option("--times", type=click.IntRange(min=1), default=1, show_default=True,
-                        metavar="K", help="Apply the pumping K times (with --pump).")(func)
+    func = click.option("--times", type=int, default=None, callback=_times_callback,
+                        metavar="K",
+                        help=f"Apply the pumping K times (needs --pump; 1 to {PUMP_MAX_TIMES}, "
+                             f"default 1; {_TIMES_REASON}).")(func)
     func = click.option("--pump", type=click.Choice(["max", "controlled"]), default=None,
                         help="Pump up the albedo (Neumann et al. 1999, eqs. 16-21) with "
                              "g1 ('max') or g2 ('controlled').")(func)
@@ -206,18 +221,37 @@ def model_options(func: Callable) -> Callable:
 
 # --------------------------------------------------------------------------- directions
 def parse_direction(text: str, option: str = "--wi") -> np.ndarray:
-    """``THETA,PHI`` in degrees (polar angle from the normal, azimuth) → unit vector (3,)."""
+    """``THETA,PHI`` in degrees → unit vector (3,) in the local frame (normal +z).
+
+    THETA is the polar angle from the normal, in [0, :data:`THETA_MAX_DEG`]:
+    above 90 the direction is below the horizon, where every BRDF is 0. PHI
+    is the azimuth, any finite number of degrees (periodic).
+
+    Raises
+    ------
+    BrdfkitError
+        Not two numbers, THETA outside [0, 180], or a non-finite angle; the
+        message names *option*, the allowed range and the value.
+    """
+    example = f"(e.g. {option} 30,0)"
     parts = str(text).split(",")
     try:
         if len(parts) != 2:
             raise ValueError
         theta, phi = (float(s) for s in parts)
-        if not (math.isfinite(theta) and math.isfinite(phi)):
-            raise ValueError
     except ValueError:
         raise BrdfkitError(
-            f"{option} must be THETA,PHI in degrees (e.g. {option} 30,0); got {text!r}"
+            f"{option} must be THETA,PHI in degrees {example}; got {text!r}"
         ) from None
+    if not 0.0 <= theta <= THETA_MAX_DEG:  # also refuses NaN
+        raise BrdfkitError(
+            f"{option} THETA,PHI: the polar angle THETA must lie in [0, {THETA_MAX_DEG:g}] "
+            f"degrees (above 90 is below the horizon, where the BRDF is 0) {example}; "
+            f"got THETA = {parts[0].strip()} in {text!r}")
+    if not math.isfinite(phi):
+        raise BrdfkitError(
+            f"{option} THETA,PHI: the azimuth PHI must be a finite number of degrees "
+            f"{example}; got PHI = {parts[1].strip()} in {text!r}")
     t, f = math.radians(theta), math.radians(phi)
     return np.array([math.sin(t) * math.cos(f), math.sin(t) * math.sin(f), math.cos(t)])
 

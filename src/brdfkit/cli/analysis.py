@@ -5,10 +5,12 @@ Analysis commands: ``albedo``, ``check``, ``table2``, ``figure``
 - ``brdfkit albedo MODEL -p ... [--theta 0:89.9:90] [--json|--csv] [--plot FILE]``
 - ``brdfkit check MODEL -p ... [--json]`` — reciprocity and energy verdicts.
 - ``brdfkit table2 [--json | --markdown]`` — Lewis's Table 2 for every model.
-- ``brdfkit figure NAME --out FILE`` — a paper figure (PNG or SVG).
+- ``brdfkit figure NAME --out FILE`` — a paper figure (PNG or SVG);
+  ``brdfkit figure list`` — the names.
 
 Angles are in degrees on the command line. Files are written atomically
-(temp file + ``os.replace``).
+(temp file + ``os.replace``). Plain click commands; :mod:`brdfkit.cli` adds
+them to the ``brdfkit`` group.
 """
 
 from __future__ import annotations
@@ -16,33 +18,54 @@ from __future__ import annotations
 import click
 import numpy as np
 
-from brdfkit.cli import main
-from brdfkit.cli._common import build_model, emit_json, handle_errors, model_options
+import brdfkit.cli._progress as _progress
+from brdfkit.cli._common import build_model, emit_json, model_options
 from brdfkit.errors import BrdfkitError
 
-__all__ = ["parse_theta"]
+__all__ = ["MAX_ANGLES", "parse_theta", "albedo_cmd", "check_cmd", "table2_cmd", "figure_cmd"]
+
+#: Largest number of --theta angles. Each angle is an adaptive quadrature (milliseconds
+#: to seconds), so 100 000 is already hours of work and megabytes of output; the cap turns
+#: a typo such as 0:89:1000000000000 into an error instead of a memory error.
+MAX_ANGLES = 100_000
+
+_THETA_FORMS = ("--theta must be START:STOP:COUNT (COUNT angles, inclusive, like "
+                "numpy.linspace) or a comma-separated list, in degrees (e.g. 0:89.9:90 or "
+                "0,30,60)")
 
 
 def parse_theta(text: str) -> np.ndarray:
-    """``START:STOP:COUNT`` (inclusive, like numpy.linspace) or ``a,b,c`` in degrees → degrees."""
+    """``START:STOP:COUNT`` (inclusive, like numpy.linspace) or ``a,b,c`` in degrees → degrees.
+
+    Raises
+    ------
+    BrdfkitError
+        Malformed spec, an empty list item (``0,,30``), COUNT < 1 or more than
+        :data:`MAX_ANGLES` angles, or an angle outside [0, 90) degrees.
+    """
     s = str(text).strip()
-    try:
-        if ":" in s:
-            parts = s.split(":")
+    if ":" in s:
+        parts = s.split(":")
+        try:
             if len(parts) != 3:
                 raise ValueError
             start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
-            if count < 1:
-                raise ValueError
-            out = np.linspace(start, stop, count)
-        else:
-            out = np.array([float(x) for x in s.split(",") if x.strip() != ""])
-            if out.size == 0:
-                raise ValueError
-    except ValueError:
-        raise BrdfkitError(
-            f"--theta must be START:STOP:COUNT or a comma-separated list, in degrees "
-            f"(e.g. 0:89.9:90 or 0,30,60); got {text!r}") from None
+        except ValueError:
+            raise BrdfkitError(f"{_THETA_FORMS}; got {text!r}") from None
+        if not 1 <= count <= MAX_ANGLES:
+            raise BrdfkitError(f"--theta COUNT must be from 1 to {MAX_ANGLES} angles; got "
+                               f"{count} in {text!r}")
+        out = np.linspace(start, stop, count)
+    else:
+        items = [x.strip() for x in s.split(",")]
+        if any(x == "" for x in items):
+            raise BrdfkitError(f"{_THETA_FORMS}; got an empty item in {text!r}")
+        if len(items) > MAX_ANGLES:
+            raise BrdfkitError(f"--theta may list at most {MAX_ANGLES} angles; got {len(items)}")
+        try:
+            out = np.array([float(x) for x in items])
+        except ValueError:
+            raise BrdfkitError(f"{_THETA_FORMS}; got {text!r}") from None
     if not np.all(np.isfinite(out)) or np.any((out < 0.0) | (out >= 90.0)):
         bad = out[~((out >= 0.0) & (out < 90.0))]
         raise BrdfkitError(f"--theta angles must lie in [0, 90) degrees; got {bad.flat[0]:g}")
@@ -53,19 +76,19 @@ def _describe(m, fallback: str) -> dict:
     return m.to_dict() if hasattr(m, "to_dict") else {"model": fallback, "params": {}}
 
 
-@main.command("albedo")
+@click.command("albedo")
 @model_options
 @click.option("--theta", default="0:89.9:90", show_default=True, metavar="SPEC",
-              help="Incidence angles in DEGREES: START:STOP:COUNT (inclusive) or a "
-                   "comma-separated list.")
+              help="Incidence angles in DEGREES, each in [0, 90): START:STOP:COUNT "
+                   f"(inclusive) or a comma-separated list; at most {MAX_ANGLES} angles.")
 @click.option("--tol", type=float, default=1e-7, show_default=True,
               help="Absolute accuracy goal of the quadrature.")
 @click.option("--json", "as_json", is_flag=True,
               help='Print {"model", "params", "theta_deg", "albedo", "error"}.')
 @click.option("--csv", "as_csv", is_flag=True, help="Print CSV: theta_deg, albedo(s), error(s).")
 @click.option("--plot", "plot", default=None, metavar="FILE",
-              help="Also write a plot of a(theta_i) to FILE (.png or .svg).")
-@handle_errors
+              help="Also write a plot of a(theta_i) to FILE (.png or .svg; the directory "
+                   "must exist).")
 def albedo_cmd(model, param, pump, times, theta, tol, as_json, as_csv, plot):
     """Directional albedo a(theta_i) = int f_r cos(theta_o) dw_o of MODEL, with error estimates.
 
@@ -73,11 +96,14 @@ def albedo_cmd(model, param, pump, times, theta, tol, as_json, as_csv, plot):
     brdfkit albedo modified-phong -p n=5000 --theta 0:89:90 --json
     """
     from brdfkit.analysis import albedo
+    from brdfkit.figures import check_output_path
 
     if as_json and as_csv:
         raise BrdfkitError("give at most one of --json and --csv")
     m = build_model(model, param, pump=pump, times=times)
     th = parse_theta(theta)
+    if plot:
+        check_output_path(plot, option="--plot")  # fail before the quadrature, not after
     r = albedo(m, np.radians(th), tol=tol)
     d = _describe(m, model)
     a = np.asarray(r.albedo)
@@ -132,18 +158,17 @@ def _plot_albedo(th, a, name, path):
     ax.set_title(f"directional albedo of {name}", fontsize=10)
     ax.grid(alpha=0.3)
     try:
-        save_atomic(fig, path)
+        save_atomic(fig, path, option="--plot")
     finally:
         plt.close(fig)
 
 
-@main.command("check")
+@click.command("check")
 @model_options
 @click.option("--json", "as_json", is_flag=True,
               help='Print {"model", "params", "reciprocal", "max_asymmetry", "energy", '
                    '"max_albedo", "theta_max_deg", "divergence_exponent", "max_scale", '
                    '"notes", ...}.')
-@handle_errors
 def check_cmd(model, param, pump, times, as_json):
     """Plausibility verdict of MODEL: reciprocity, energy conservation, objections.
 
@@ -175,12 +200,11 @@ def check_cmd(model, param, pump, times, as_json):
         click.echo(f"note:         {n}")
 
 
-@main.command("table2")
+@click.command("table2")
 @click.option("--json", "as_json", is_flag=True, help="Print the rows as JSON.")
 @click.option("--markdown", "as_md", is_flag=True, help="Print a Markdown table.")
 @click.option("--model", "models", multiple=True, metavar="NAME",
               help="Only these models (repeatable; default: every registered model).")
-@handle_errors
 def table2_cmd(as_json, as_md, models):
     """Lewis (1993) Table 2 regenerated by computation, extended to every registered model.
 
@@ -193,7 +217,9 @@ def table2_cmd(as_json, as_md, models):
 
     if as_json and as_md:
         raise BrdfkitError("give at most one of --json and --markdown")
-    rows = table2(models=models or None)
+    show = not as_json and _progress.stderr_is_interactive()
+    with _progress.counter("table2", enabled=show) as progress:
+        rows = table2(models=models or None, progress=progress)
     if as_json:
         emit_json(rows)
     elif as_md:
@@ -206,23 +232,34 @@ def table2_cmd(as_json, as_md, models):
         click.echo(format_table(rows))
 
 
-@main.command("figure")
+@click.command("figure")
 @click.argument("name", metavar="NAME")
-@click.option("--out", "out", required=True, metavar="FILE", help="Output file (.png or .svg).")
-@click.option("--dpi", type=click.IntRange(min=30, max=1200), default=150, show_default=True)
-@handle_errors
+@click.option("--out", "out", default=None, metavar="FILE",
+              help="Output file (.png or .svg; the directory must exist). Required to build a "
+                   "figure; not used by 'figure list'.")
+@click.option("--dpi", type=click.IntRange(min=30, max=1200), default=150, show_default=True,
+              help="Resolution of PNG output, 30 to 1200.")
 def figure_cmd(name, out, dpi):
     """Reproduce a paper figure by computation and write it to FILE (PNG or SVG).
 
     NAME is one of the registered figures (e.g. lewis-fig5, lewis-fig7,
-    lewis-fig8, lewis-fig9, neumann-fig1); 'brdfkit figure list --out -'
-    prints them.
+    lewis-fig8, lewis-fig9, neumann-fig1 ... neumann-fig7); 'brdfkit figure
+    list' prints them. Building takes seconds to a minute; when stderr is a
+    terminal a 'building ...' line shows it is working.
     """
-    from brdfkit.figures import figure_names, save_figure
+    from brdfkit.figures import check_output_path, figure_names, resolve_figure, save_figure
 
     if name == "list":
+        if out is not None:
+            raise BrdfkitError(f"'figure list' only prints the names and writes no file; "
+                               f"drop --out {out}")
         click.echo("\n".join(figure_names()))
         return
-    save_figure(name, out, dpi=dpi)
+    if out is None:
+        raise BrdfkitError(f"figure {name} needs --out FILE (.png or .svg), e.g. "
+                           f"brdfkit figure {name} --out {name}.png")
+    key = resolve_figure(name)  # name and path are checked before the "building" line
+    check_output_path(out, option="--out")
+    with _progress.status(f"building {key}", enabled=_progress.stderr_is_interactive()):
+        save_figure(key, out, dpi=dpi, option="--out")
     click.echo(out)
-

@@ -21,7 +21,6 @@ import numpy as np
 
 import brdfkit
 from brdfkit.analysis import H_s, albedo
-from brdfkit.figures import register_figure
 
 THETA_DEG = np.concatenate([np.linspace(0.0, 89.0, 90), [89.3, 89.6, 89.8, 89.9]])
 BETAS_DEG = (5.0, 15.0, 30.0)
@@ -48,7 +47,6 @@ def _curve(model) -> np.ndarray:
     return np.asarray(albedo(model, np.radians(THETA_DEG)).albedo)
 
 
-@register_figure("lewis-fig5")
 def lewis_fig5():
     """H_s(θ_i) for Phong's F_s^P (left) and Blinn's F_s^B (right), several exponents."""
     fig, (a1, a2) = _axes("Lewis 1993, Fig. 5: specular integrals $H_s(\\mathbf{S})$", 2,
@@ -67,7 +65,6 @@ def lewis_fig5():
     return fig
 
 
-@register_figure("lewis-fig7")
 def lewis_fig7():
     """k_ρ of Phong, Blinn and Torrance–Sparrow T1–T4 (F = 1), β = 15°."""
     fig, (ax,) = _axes("Lewis 1993, Fig. 7: directional-hemispherical reflectance, "
@@ -94,7 +91,6 @@ def lewis_fig7():
     return fig
 
 
-@register_figure("lewis-fig8")
 def lewis_fig8():
     """k_ρ/b of Neumann–Neumann and Minnaert shaders for several β."""
     fig, (ax,) = _axes("Lewis 1993, Fig. 8: Neumann-Neumann and Minnaert shaders",
@@ -111,7 +107,6 @@ def lewis_fig8():
     return fig
 
 
-@register_figure("lewis-fig9")
 def lewis_fig9():
     """k_ρ^H/k_s of the reciprocal Phong–Blinn shader (eq. 24) for several β."""
     fig, (ax,) = _axes("Lewis 1993, Fig. 9: reciprocal Phong shader with Blinn's $F_s^B$",

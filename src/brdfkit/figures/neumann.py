@@ -16,7 +16,6 @@ import numpy as np
 
 import brdfkit
 from brdfkit.analysis import albedo
-from brdfkit.figures import register_figure
 
 MODELS_FIG1 = (
     ("Phong (n = 150)", "modified-phong", {"rho_d": 0.0, "rho_s": 1.0, "n": 150.0}),
@@ -27,7 +26,6 @@ MODELS_FIG1 = (
 )
 
 
-@register_figure("neumann-fig1")
 def neumann_fig1():
     """Albedo functions of Phong, He–Torrance, Cook–Torrance and Ward (F = 1)."""
     import matplotlib.pyplot as plt

@@ -29,7 +29,6 @@ import numpy as np
 
 import brdfkit
 from brdfkit.analysis import albedo
-from brdfkit.figures import register_figure
 
 THETA = np.concatenate([np.linspace(0.0, 88.0, 45), [89.0, 89.5, 89.9]])
 N_PAPER = 20.0
@@ -112,31 +111,26 @@ def _fig(model_fn, g: str, fig_no: int, model_label: str):
                       caption, ref_radiance=float(curves["radiance"][0, 0]))
 
 
-@register_figure("neumann-fig3")
 def neumann_fig3():
     """Reciprocal Phong (n = 20) pumped with g₁: albedo and mirror radiance."""
     return _fig(reciprocal_phong, "max", 3, "reciprocal Phong")
 
 
-@register_figure("neumann-fig4")
 def neumann_fig4():
     """Reciprocal Blinn (n = 20) pumped with g₁: albedo and mirror radiance."""
     return _fig(reciprocal_blinn, "max", 4, "reciprocal Blinn")
 
 
-@register_figure("neumann-fig5")
 def neumann_fig5():
     """Reciprocal Phong (n = 20) pumped with g₂: albedo and mirror radiance."""
     return _fig(reciprocal_phong, "controlled", 5, "reciprocal Phong")
 
 
-@register_figure("neumann-fig6")
 def neumann_fig6():
     """Reciprocal Blinn (n = 20) pumped with g₂: albedo and mirror radiance."""
     return _fig(reciprocal_blinn, "controlled", 6, "reciprocal Blinn")
 
 
-@register_figure("neumann-fig7")
 def neumann_fig7():
     """Eq. (22) with c_n = (n+2)/2π: albedo for several n, mirror radiance for n = 100."""
     import matplotlib.pyplot as plt

@@ -1,0 +1,110 @@
+"""The click group class behind ``brdfkit``: one-line errors and SIGTERM.
+
+- Every error reaches the user as exactly one line ``brdfkit: error:
+  <message>`` on stderr with exit status 2 — brdfkit's own
+  :class:`~brdfkit.errors.BrdfkitError` (caught here, and only here) and
+  every error click detects itself (missing option or argument, bad choice,
+  value out of range, unknown command or option). ``--help`` and
+  ``--version`` exit 0; ``brdfkit`` with no command prints the help (exit 2,
+  as click does).
+- While a command runs, SIGTERM raises :class:`SystemExit` (status 143 =
+  128 + 15, the shell convention) so that ``finally``/``except
+  BaseException`` blocks run — the atomic figure writer removes its temp
+  file — instead of the process dying on the spot. The previous handler is
+  restored afterwards (the group may run inside another program or a test).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+
+import click
+
+from brdfkit.errors import BrdfkitError
+
+__all__ = ["EXIT_USAGE", "EXIT_SIGTERM", "BrdfkitGroup", "OneLineError", "one_line"]
+
+#: Exit status for bad input (the same as click's usage errors).
+EXIT_USAGE = 2
+# Bare 'brdfkit' raises this in click >= 8.2 (shown as the help, exit 2); click 8.1, which
+# pyproject still allows, prints the help and exits 0 without raising, hence the fallback.
+_NO_ARGS_IS_HELP = getattr(click.exceptions, "NoArgsIsHelpError", ())
+
+#: Exit status after SIGTERM: 128 + signal number, as a shell reports a killed process.
+EXIT_SIGTERM = 128 + int(signal.SIGTERM)
+
+
+def one_line(message: str) -> str:
+    """*message* with every run of whitespace (newlines included) collapsed to one space."""
+    return " ".join(str(message).split())
+
+
+class OneLineError(click.ClickException):
+    """An error shown as one line ``brdfkit: error: <message>`` on stderr, exit status 2."""
+
+    exit_code = EXIT_USAGE
+
+    def show(self, file=None) -> None:
+        click.echo(f"brdfkit: error: {one_line(self.format_message())}", file=file, err=True)
+
+
+def _usage_message(exc: click.UsageError) -> str:
+    """click's message plus where to read the usage (the usage block itself is not shown)."""
+    msg = one_line(exc.format_message())
+    ctx = exc.ctx
+    if ctx is not None:
+        msg += f" (see '{ctx.command_path} --help')"
+    return msg
+
+
+def _raise_sigterm(signum, frame):  # noqa: ARG001  (signal handler signature)
+    raise SystemExit(EXIT_SIGTERM)
+
+
+@contextlib.contextmanager
+def _sigterm_raises_systemexit():
+    """Within the block, SIGTERM raises SystemExit(143); the old handler is restored after."""
+    if threading.current_thread() is not threading.main_thread():
+        yield  # signal handlers can only be set from the main thread
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_sigterm)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+class BrdfkitGroup(click.Group):
+    """Click group reporting every error as one line (exit 2) and turning SIGTERM into SystemExit.
+
+    Errors from the group's own arguments surface in :meth:`make_context`;
+    errors of a command (its options, its callback) and unknown commands in
+    :meth:`invoke`. Both convert them to :class:`OneLineError`, which click's
+    ``main`` shows and exits with.
+    """
+
+    def make_context(self, info_name, args, parent=None, **extra):
+        try:
+            return super().make_context(info_name, args, parent=parent, **extra)
+        except _NO_ARGS_IS_HELP:
+            raise  # bare 'brdfkit': the help is the useful answer
+        except click.UsageError as exc:
+            raise OneLineError(_usage_message(exc)) from exc
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except OneLineError:
+            raise
+        except click.UsageError as exc:
+            raise OneLineError(_usage_message(exc)) from exc
+        except click.ClickException as exc:
+            raise OneLineError(exc.format_message()) from exc
+        except BrdfkitError as exc:
+            raise OneLineError(str(exc)) from exc
+
+    def main(self, *args, **kwargs):
+        with _sigterm_raises_systemexit():
+            return super().main(*args, **kwargs)

@@ -1,0 +1,100 @@
+"""
+Model commands: ``models`` and ``eval``
+=======================================
+
+- ``brdfkit models [--json]`` — the registry: parameters (default, bounds,
+  unit), citation, reciprocity claim, sampler.
+- ``brdfkit eval MODEL -p NAME=VALUE ... --wi THETA,PHI --wo THETA,PHI`` —
+  one BRDF value f_r in 1/sr.
+
+Plain click commands; :mod:`brdfkit.cli` adds them to the ``brdfkit`` group.
+"""
+
+from __future__ import annotations
+
+import click
+
+import brdfkit
+from brdfkit.cli._common import build_model, emit_json, model_options, parse_direction
+
+__all__ = ["models_cmd", "eval_cmd"]
+
+
+# --------------------------------------------------------------------------- models
+def _yes(flag: bool) -> str:
+    return "yes" if flag else "no"
+
+
+def _param_row(p: dict) -> tuple[str, str, str, str]:
+    default = "none" if p["default"] is None else str(p["default"])
+    bounds = "{" + ", ".join(p["choices"]) + "}" if "choices" in p else p["bounds"]
+    per = {"colour": " per channel", "lobes": " per lobe"}.get(p["kind"], "")
+    unit = p["unit"] or "-"
+    return p["name"], default, bounds, f"{unit}{per}"
+
+
+@click.command("models")
+@click.option("--json", "as_json", is_flag=True, help="Print JSON (a list of model descriptions).")
+def models_cmd(as_json: bool) -> None:
+    """List every registered model with its parameters, citation and claims.
+
+    For each model: aliases, whether its formula claims to be reciprocal,
+    whether it has an importance sampler, the citation (paper and equation),
+    and each parameter's default, bounds and unit. 'beta' (where listed) is
+    the lobe half-angle alternative to the width parameter, in degrees on the
+    command line.
+    """
+    descriptions = [cls.describe() for cls in brdfkit.MODELS.values()]
+    if as_json:
+        emit_json(descriptions)
+        return
+    click.echo(f"{len(descriptions)} models (reciprocal = formula claims f(wi,wo) = f(wo,wi); "
+               "sampler = importance sampler beyond the cosine fallback)\n")
+    for d in descriptions:
+        aliases = f"  (aliases: {', '.join(d['aliases'])})" if d["aliases"] else ""
+        click.echo(f"{d['name']}{aliases}")
+        click.echo(f"    reciprocal: {_yes(d['reciprocal'])}   sampler: {_yes(d['has_sampler'])}"
+                   f"   cite: {d['citation']}")
+        if d["summary"]:
+            click.echo(f"    {d['summary']}")
+        rows = [_param_row(p) for p in d["params"]]
+        if d["beta"]:
+            rows.append(("beta", "-", "(0, 90)", f"deg (sets {d['beta']})"))
+        widths = [max(len(r[i]) for r in rows) for i in range(4)] if rows else []
+        for r in rows:
+            click.echo("      " + "  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True))
+                       .rstrip())
+        click.echo("")
+
+
+# --------------------------------------------------------------------------- eval
+@click.command("eval")
+@model_options
+@click.option("--wi", required=True, metavar="THETA,PHI",
+              help="Direction toward the light: polar angle from the normal and azimuth, "
+                   "in DEGREES.")
+@click.option("--wo", required=True, metavar="THETA,PHI",
+              help="Direction toward the viewer: polar angle and azimuth, in DEGREES.")
+@click.option("--json", "as_json", is_flag=True,
+              help='Print {"model": ..., "params": {...}, "value": ...} (a list per channel).')
+def eval_cmd(model: str, param: tuple[str, ...], pump: str | None, times: int, wi: str, wo: str,
+             as_json: bool) -> None:
+    """Evaluate the BRDF f_r(wi, wo) of MODEL in 1/sr (without the cosine factor).
+
+    Example: brdfkit eval modified-phong -p rho_s=0.5 -p n=50 --wi 30,0 --wo 30,180
+
+    THETA is the polar angle from the normal in [0, 180] degrees; above 90
+    the direction is below the horizon and the BRDF is 0 there. PHI is the
+    azimuth in degrees. 'beta' is given in degrees here.
+    """
+    m = build_model(model, param, pump=pump, times=times)
+    vi = parse_direction(wi, "--wi")
+    vo = parse_direction(wo, "--wo")
+    value = m.eval(vi, vo)
+    if as_json:
+        d = m.to_dict() if hasattr(m, "to_dict") else {"model": model, "params": {}}
+        emit_json({"model": d["model"], "params": d["params"],
+                   **({"pump": d["pump"]} if "pump" in d else {}), "value": value})
+        return
+    v = value.tolist() if hasattr(value, "tolist") else value
+    click.echo(" ".join(repr(float(x)) for x in v) if isinstance(v, list) else repr(float(v)))

@@ -1,0 +1,70 @@
+"""The figure registry: every figure name listed once, explicitly.
+
+Each figure module (:mod:`~brdfkit.figures.lewis`,
+:mod:`~brdfkit.figures.neumann`, :mod:`~brdfkit.figures.pumping`) defines
+plain functions and imports nothing from :mod:`brdfkit.figures`; this module
+imports them (downward) and names them. To add a figure, write the function
+in its paper's module and add one line to :data:`FIGURES`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from types import MappingProxyType
+
+from brdfkit.errors import BrdfkitError
+from brdfkit.figures import lewis, neumann
+from brdfkit.figures import pumping as pumping_figures
+from brdfkit.figures._save import check_output_path, save_atomic
+
+__all__ = ["FIGURES", "figure_names", "resolve_figure", "make_figure", "save_figure"]
+
+#: name → function returning a Matplotlib Figure (read-only: edit the list here).
+FIGURES: Mapping[str, Callable] = MappingProxyType({
+    "lewis-fig5": lewis.lewis_fig5,
+    "lewis-fig7": lewis.lewis_fig7,
+    "lewis-fig8": lewis.lewis_fig8,
+    "lewis-fig9": lewis.lewis_fig9,
+    "neumann-fig1": neumann.neumann_fig1,
+    "neumann-fig3": pumping_figures.neumann_fig3,
+    "neumann-fig4": pumping_figures.neumann_fig4,
+    "neumann-fig5": pumping_figures.neumann_fig5,
+    "neumann-fig6": pumping_figures.neumann_fig6,
+    "neumann-fig7": pumping_figures.neumann_fig7,
+})
+
+
+def figure_names() -> list[str]:
+    """Registered figure names, sorted."""
+    return sorted(FIGURES)
+
+
+def resolve_figure(name: str) -> str:
+    """The registered name for *name* (case and surrounding blanks ignored), or BrdfkitError."""
+    key = str(name).strip().lower()
+    if key not in FIGURES:
+        raise BrdfkitError(f"unknown figure {name!r}; valid names: " + ", ".join(figure_names()))
+    return key
+
+
+def make_figure(name: str):
+    """Build the figure *name* (a Matplotlib Figure)."""
+    return FIGURES[resolve_figure(name)]()
+
+
+def save_figure(name: str, path, *, dpi: int = 150, option: str = "path") -> str:
+    """Build figure *name* and write it to *path* (.png or .svg); return *path*.
+
+    The name and the path are checked before the (possibly long) computation.
+    *option* is how the caller names *path* in error messages (the CLI passes
+    ``"--out"``).
+    """
+    import matplotlib.pyplot as plt
+
+    key = resolve_figure(name)
+    check_output_path(path, option=option)
+    fig = FIGURES[key]()
+    try:
+        return save_atomic(fig, path, dpi=dpi, option=option)
+    finally:
+        plt.close(fig)
