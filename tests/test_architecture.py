@@ -24,6 +24,7 @@ LAYER = {
     # material specs): layer 2, so the data layer is below it and cli/figures above
     "": 2, "models": 1,
     "analysis": 2, "data": 2,
+    "chi2": 2,  # the old name of brdfkit.analysis.chi2, an alias of that module
     "pumping": 3, "fitting": 3, "render": 3,
     "figures": 4, "cli": 4, "report": 4, "explorer": 4, "__main__": 4,
 }
@@ -109,3 +110,19 @@ def test_protocol_hooks_are_not_probed(path):
             assert node.args[1].value not in HOOKS, (
                 f"{path}:{node.lineno}: {node.func.id}(..., {node.args[1].value!r}) probes a "
                 "declared protocol hook; read the attribute (models.BRDF declares it)")
+
+
+def test_no_name_shadows_a_module():
+    # e.g. the function brdfkit.analysis.albedo once shadowed the module of the same name
+    import importlib
+    import pkgutil
+
+    for init in SRC.rglob("__init__.py"):
+        pkg_name = ".".join(("brdfkit", *init.parent.relative_to(SRC).parts))
+        pkg = importlib.import_module(pkg_name)
+        for info in pkgutil.iter_modules([str(init.parent)]):
+            attr = pkg.__dict__.get(info.name)
+            if attr is None:
+                continue
+            assert getattr(attr, "__name__", None) == f"{pkg_name}.{info.name}", (
+                f"{pkg_name}.{info.name} is {attr!r}, which shadows the module of that name")

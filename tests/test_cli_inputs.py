@@ -357,7 +357,7 @@ def test_figure_list_refuses_out_and_building_needs_out():
 
 # --------------------------------------------------------------------------- progress
 def test_table2_progress_callback_does_not_change_rows():
-    from brdfkit.analysis.table2 import table2
+    from brdfkit.analysis.lewis_table2 import table2
 
     calls = []
     rows = table2(models=["lambert", "minnaert"],

@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 
 import brdfkit.data as bd
-from brdfkit.analysis.albedo import albedo
+from brdfkit.analysis.albedo_engine import albedo
 from brdfkit.data import catalog
 from brdfkit.data.merl import MeasuredBRDF, bin_centres, half_diff_to_directions
 from brdfkit.data.surrogates import SurrogateBRDF, nbrdf_kernel

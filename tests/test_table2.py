@@ -7,7 +7,7 @@ import json
 import pytest
 from click.testing import CliRunner
 
-from brdfkit.analysis.table2 import LEWIS_ROWS, format_markdown, format_table, table2
+from brdfkit.analysis.lewis_table2 import LEWIS_ROWS, format_markdown, format_table, table2
 from brdfkit.cli import main
 
 LEWIS_MODELS = [r[1] for r in LEWIS_ROWS]

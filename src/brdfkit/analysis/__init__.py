@@ -5,15 +5,16 @@ Analysis: albedo, plausibility verdicts and Lewis's Table 2
 Public objects
 --------------
 - :func:`albedo`, :class:`AlbedoResult` — deterministic directional albedo
-  with an error estimate (module :mod:`brdfkit.analysis.albedo`; note that
-  the package attribute ``brdfkit.analysis.albedo`` is the function).
+  with an error estimate and a status per angle (module
+  :mod:`brdfkit.analysis.albedo_engine`; its compiled core is
+  :mod:`brdfkit.analysis.quadrature`).
 - :func:`albedo_mc` — importance-sampled Monte-Carlo albedo.
 - :func:`hemispherical_albedo` — ρ_hh.
 - :func:`H_s` — Lewis's specular integral (§4.1, Fig. 5).
 - :func:`check`, :class:`Verdict` — reciprocity and energy verdicts
   (:mod:`brdfkit.analysis.plausibility`).
 - :func:`table2` — Lewis's Table 2 regenerated for every registered model
-  (:mod:`brdfkit.analysis.table2`).
+  (:mod:`brdfkit.analysis.lewis_table2`).
 
 References
 ----------
@@ -21,9 +22,9 @@ References
 - [Neumann1999] §1.2, §2.1, Fig. 1.
 """
 
-from brdfkit.analysis.albedo import AlbedoResult, H_s, albedo, albedo_mc, hemispherical_albedo
+from brdfkit.analysis.albedo_engine import AlbedoResult, H_s, albedo, albedo_mc, hemispherical_albedo
 from brdfkit.analysis.plausibility import Verdict, check
-from brdfkit.analysis.table2 import table2
+from brdfkit.analysis.lewis_table2 import table2
 
 __all__ = ["AlbedoResult", "H_s", "Verdict", "albedo", "albedo_mc", "check",
            "hemispherical_albedo", "table2"]

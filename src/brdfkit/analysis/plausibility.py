@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from brdfkit.analysis.albedo import albedo, evaluate_pairs
+from brdfkit.analysis.albedo_engine import albedo, evaluate_pairs
 from brdfkit.errors import BrdfkitError
 from brdfkit.models._base import BRDF
 

@@ -72,10 +72,6 @@ def parse_theta(text: str) -> np.ndarray:
     return out
 
 
-def _describe(m, fallback: str) -> dict:
-    return m.to_dict() if hasattr(m, "to_dict") else {"model": fallback, "params": {}}
-
-
 @click.command("albedo")
 @model_options
 @click.option("--theta", default="0:89.9:90", show_default=True, metavar="SPEC",
@@ -105,11 +101,11 @@ def albedo_cmd(model, param, pump, times, theta, tol, as_json, as_csv, plot):
     if plot:
         check_output_path(plot, option="--plot")  # fail before the quadrature, not after
     r = albedo(m, np.radians(th), tol=tol)
-    d = _describe(m, model)
+    d = m.to_dict()
     a = np.asarray(r.albedo)
     e = np.asarray(r.error)
     if plot:
-        _plot_albedo(th, a, getattr(m, "name", d["model"]), plot)
+        _plot_albedo(th, a, m.name, plot)
     if as_json:
         emit_json({"model": d["model"], "params": d["params"],
                    **({"pump": d["pump"]} if "pump" in d else {}),
@@ -213,7 +209,7 @@ def table2_cmd(as_json, as_md, models):
     maximum albedo, the paper's claim where Lewis's Table 2 or Neumann et al.
     make one, whether they agree, and notes with the reasons.
     """
-    from brdfkit.analysis.table2 import format_markdown, format_table, table2
+    from brdfkit.analysis.lewis_table2 import format_markdown, format_table, table2
 
     if as_json and as_md:
         raise BrdfkitError("give at most one of --json and --markdown")

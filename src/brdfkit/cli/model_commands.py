@@ -92,7 +92,7 @@ def eval_cmd(model: str, param: tuple[str, ...], pump: str | None, times: int, w
     vo = parse_direction(wo, "--wo")
     value = m.eval(vi, vo)
     if as_json:
-        d = m.to_dict() if hasattr(m, "to_dict") else {"model": model, "params": {}}
+        d = m.to_dict()
         emit_json({"model": d["model"], "params": d["params"],
                    **({"pump": d["pump"]} if "pump" in d else {}), "value": value})
         return

@@ -7,7 +7,7 @@ Phong of eq. 6), He–Torrance (σ₀ = 0.1, τ = 1.7), Cook–Torrance (m = 0.1
 and Ward (m = 0.1), Fresnel = 1, by deterministic quadrature. The inset
 extends θ_i to 89.999° on a log axis of cos θ_i: Ward diverges like
 (cos θ_i)^−½ as Neumann §2.1 says; Cook–Torrance does not (see
-:mod:`brdfkit.analysis.table2`).
+:mod:`brdfkit.analysis.lewis_table2`).
 """
 
 from __future__ import annotations
