@@ -22,9 +22,15 @@ References
 - [Neumann1999] §1.2, §2.1, Fig. 1.
 """
 
-from brdfkit.analysis.albedo_engine import AlbedoResult, H_s, albedo, albedo_mc, hemispherical_albedo
-from brdfkit.analysis.plausibility import Verdict, check
+from brdfkit.analysis.albedo_engine import (
+           AlbedoResult,
+           H_s,
+           albedo,
+           albedo_mc,
+           hemispherical_albedo,
+)
 from brdfkit.analysis.lewis_table2 import table2
+from brdfkit.analysis.plausibility import Verdict, check
 
 __all__ = ["AlbedoResult", "H_s", "Verdict", "albedo", "albedo_mc", "check",
            "hemispherical_albedo", "table2"]
