@@ -24,7 +24,6 @@ LAYER = {
     # material specs): layer 2, so the data layer is below it and cli/figures above
     "": 2, "models": 1,
     "analysis": 2, "data": 2,
-    "chi2": 2,  # the old name of brdfkit.analysis.chi2, an alias of that module
     "pumping": 3, "fitting": 3, "render": 3,
     "figures": 4, "cli": 4, "report": 4, "explorer": 4, "__main__": 4,
 }

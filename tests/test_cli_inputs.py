@@ -223,7 +223,6 @@ def test_pump_default_times_is_one():
     assert m.stages == ["max"]
 
 
-@pytest.mark.xfail(strict=False, reason="pumping.MAX_TIMES arrives with the pumping split")
 def test_cli_times_bound_matches_pumping():
     assert PUMP_MAX_TIMES == brdfkit.pumping.MAX_TIMES
 

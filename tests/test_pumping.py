@@ -152,7 +152,7 @@ def test_sampler_is_base_sampler(phong, phong_max):
 
 
 def test_chi2_on_pumped_model(blinn_ctrl):
-    from brdfkit.chi2 import chi2_test
+    from brdfkit.analysis.chi2 import chi2_test
 
     res = chi2_test(blinn_ctrl[1], _dirs(np.radians(60.0)), n_samples=50_000, seed=4)
     assert res.passed, res.message

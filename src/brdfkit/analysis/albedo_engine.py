@@ -678,10 +678,16 @@ def H_s(theta_i, n: float, *, lobe: str = "phong", tol: float = 1e-8) -> AlbedoR
 
     if lobe not in ("phong", "blinn"):
         raise ParameterError(f"lobe must be 'phong' or 'blinn'; got {lobe!r}")
-    n = float(n)
-    if not (n >= 0.0 and math.isfinite(n)):
+    try:
+        n_val = float(n)
+    except (TypeError, ValueError):
+        n_val = float("nan")
+    if not (n_val >= 0.0 and math.isfinite(n_val)):
         raise ParameterError(f"n must be a finite number >= 0; got {n!r}")
     th = check_theta(theta_i)
-    _check_tol(tol)
-    value, error = specular_integral_with_error(th, n, lobe)
-    return AlbedoResult(theta=th.copy(), albedo=value, error=error)
+    tol = _check_tol(tol)
+    value, error = specular_integral_with_error(th, n_val, lobe)
+    # the same goal as the engine's: the tolerance or 1e-10 relative
+    met = np.asarray(error) <= np.maximum(tol, 1e-10 * np.abs(value))
+    status = np.where(met, CONVERGED, MAX_LEVEL_REACHED).astype(np.int8)
+    return AlbedoResult(theta=th.copy(), albedo=value, error=error, status=status)

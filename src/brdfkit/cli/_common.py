@@ -31,6 +31,7 @@ import numpy as np
 from brdfkit.cli._group import EXIT_USAGE
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models import resolve
+from brdfkit.pumping import MAX_TIMES
 from brdfkit.pumping import pump as pump_model
 
 __all__ = [
@@ -45,10 +46,9 @@ __all__ = [
     "emit_json",
 ]
 
-#: Largest ``--times``. Each pumping tabulates the previous stage's albedo, so the cost
-#: grows with the number of stages (times = 8 takes about a minute; 16 did not finish in
-#: 9 minutes, issue 8). MUST equal ``brdfkit.pumping.MAX_TIMES`` (tests/test_cli_inputs.py checks).
-PUMP_MAX_TIMES = 8
+#: Largest ``--times``: the library's bound (each pumping tabulates the previous stage's
+#: albedo, so the cost grows with the number of stages; see ``brdfkit.pumping.MAX_TIMES``).
+PUMP_MAX_TIMES = MAX_TIMES
 _TIMES_REASON = ("each pumping tabulates the previous stage's albedo, so the cost grows with "
                  "the number of stages: times=8 takes about a minute")
 
