@@ -20,44 +20,50 @@ __all__ = ["write_atomic", "check_output_path"]
 
 
 def check_output_path(path, *, option: str = "path", suffixes: tuple[str, ...] = ()) -> str:
-    """*path* as a string, its directory existing and writable and its suffix allowed.
+    """*path* as a string whose directory exists and whose suffix is allowed.
+
+    Call it before expensive work so that a typo fails at once. *option* is how
+    the caller names the path in messages (the CLI passes ``"--out"`` or
+    ``"--plot"``; the API says ``"path"``).
 
     Raises
     ------
     BrdfkitError
-        Naming *option*, the path and the problem (suffix, missing directory,
-        not writable, a directory in the way).
+        Naming *option*, the path and the problem (suffix, a directory in the
+        way, missing directory) and the fix.
     """
     p = os.fspath(path)
     if suffixes and not p.lower().endswith(tuple(s.lower() for s in suffixes)):
         raise BrdfkitError(f"{option} must end in {' or '.join(suffixes)}; got {p!r}")
+    if os.path.isdir(p):
+        raise BrdfkitError(f"{option} {p!r} is a directory; give a file name")
     directory = os.path.dirname(os.path.abspath(p))
     if not os.path.isdir(directory):
-        raise BrdfkitError(f"{option}: output directory does not exist: {directory}")
-    if not os.access(directory, os.W_OK):
-        raise BrdfkitError(f"{option}: output directory is not writable: {directory}")
-    if os.path.isdir(p):
-        raise BrdfkitError(f"{option}: {p!r} is a directory, not a file name")
+        raise BrdfkitError(f"{option} {p!r}: the directory {directory!r} does not exist; "
+                           "create it first or choose another path")
     return p
 
 
 def write_atomic(path, write: Callable[[BinaryIO], None], *, option: str = "path") -> str:
     """Call ``write(fh)`` on a temporary file next to *path*, then rename it to *path*.
 
-    The file gets the mode a plain ``open()`` would give it (the umask applied to
-    0o666; ``mkstemp`` would leave 0o600). On any exception — including
-    KeyboardInterrupt and SystemExit (SIGTERM in the CLI) — the temporary file is
-    removed and the exception re-raised; an OSError becomes a BrdfkitError naming
-    the path.
+    The temporary file is ``.brdfkit-XXXX<suffix>`` in the target directory, so
+    *path* is either the old file or the complete new one. It gets the mode a
+    plain ``open()`` would give it (the umask applied to 0o666; ``mkstemp`` would
+    leave 0o600). On any exception — including KeyboardInterrupt and SystemExit
+    (the command line's SIGTERM handler) — the temporary file is removed and the
+    exception re-raised; an OSError becomes a BrdfkitError naming *option*, the
+    path and the reason (unwritable directory, read-only or pseudo file system
+    such as ``/proc``).
     """
     p = check_output_path(path, option=option)
     directory = os.path.dirname(os.path.abspath(p))
-    base = os.path.basename(p)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{base}.", suffix=".brdfkit-tmp", dir=directory)
+        fd, tmp = tempfile.mkstemp(prefix=".brdfkit-", suffix=os.path.splitext(p)[1],
+                                   dir=directory)
     except OSError as exc:
-        raise BrdfkitError(f"{option}: cannot create a file in {directory}: "
-                           f"{exc.strerror or exc}") from None
+        raise BrdfkitError(f"{option} {p!r}: cannot create a file in {directory!r} "
+                           f"({exc.strerror or exc}); choose a writable directory") from None
     try:
         with os.fdopen(fd, "wb") as fh:
             write(fh)
@@ -69,6 +75,7 @@ def write_atomic(path, write: Callable[[BinaryIO], None], *, option: str = "path
         if os.path.exists(tmp):
             os.unlink(tmp)
         if isinstance(exc, OSError):
-            raise BrdfkitError(f"{option}: cannot write {p!r}: {exc.strerror or exc}") from None
+            raise BrdfkitError(f"{option} {p!r}: cannot write the file "
+                               f"({exc.strerror or exc})") from None
         raise
     return p

@@ -13,7 +13,6 @@ Public objects (re-exported by :mod:`brdfkit.figures`)
 from __future__ import annotations
 
 import os
-import tempfile
 
 import matplotlib
 
@@ -21,6 +20,7 @@ import matplotlib
 # figure is built (the figure modules import pyplot inside their functions, never at import).
 matplotlib.use("Agg")
 
+from brdfkit import _io  # noqa: E402
 from brdfkit.errors import BrdfkitError  # noqa: E402
 
 __all__ = ["FORMATS", "check_output_path", "save_atomic"]
@@ -32,9 +32,8 @@ FORMATS = ("png", "svg")
 def check_output_path(path, *, option: str = "path") -> tuple[str, str]:
     """Check that a figure can be written to *path*; return ``(path, format)``.
 
-    Call it before expensive work so that a typo fails at once. *option* is
-    how the caller names the path in messages (the CLI passes ``"--out"`` or
-    ``"--plot"``; the API says ``"path"``).
+    :func:`brdfkit._io.check_output_path` with the figure formats: the suffix
+    must be ``.png`` or ``.svg`` (the format is taken from it).
 
     Raises
     ------
@@ -47,24 +46,16 @@ def check_output_path(path, *, option: str = "path") -> tuple[str, str]:
     if ext not in FORMATS:
         raise BrdfkitError(f"{option} must end in .png or .svg (the format is taken from the "
                            f"suffix); got {path!r}")
-    if os.path.isdir(path):
-        raise BrdfkitError(f"{option} {path!r} is a directory; give a file name ending in "
-                           f".{ext}")
-    directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
-        raise BrdfkitError(f"{option} {path!r}: the directory {directory!r} does not exist; "
-                           "create it first or choose another path")
-    return path, ext
+    return _io.check_output_path(path, option=option), ext
 
 
 def save_atomic(fig, path, *, dpi: int = 150, option: str = "path") -> str:
-    """Save *fig* to *path* (format from the suffix: .png or .svg) via a temp file + os.replace.
+    """Save *fig* to *path* (format from the suffix: .png or .svg), atomically.
 
-    The figure is written to ``.brdfkit-XXXX.<ext>`` in the target directory
-    and renamed over *path*, so *path* is either the old file or the complete
-    new one. Any exception — including :class:`SystemExit` raised by the
-    command line's SIGTERM handler and :class:`KeyboardInterrupt` — removes the
-    temp file before it propagates.
+    Written through :func:`brdfkit._io.write_atomic`: *path* is either the old
+    file or the complete new one, and any exception — including
+    :class:`SystemExit` raised by the command line's SIGTERM handler — removes
+    the temporary ``.brdfkit-XXXX.<ext>`` file before it propagates.
 
     Parameters
     ----------
@@ -79,30 +70,10 @@ def save_atomic(fig, path, *, dpi: int = 150, option: str = "path") -> str:
     ------
     BrdfkitError
         Bad suffix, missing directory (see :func:`check_output_path`), or the
-        operating system refused the write (unwritable directory, read-only or
-        pseudo file system such as ``/proc``): the message names *option*, the
+        operating system refused the write: the message names *option*, the
         path and the reason.
     """
     path, ext = check_output_path(path, option=option)
-    directory = os.path.dirname(os.path.abspath(path))
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=".brdfkit-", suffix="." + ext, dir=directory)
-    except OSError as exc:
-        raise BrdfkitError(f"{option} {path!r}: cannot create a file in {directory!r} "
-                           f"({exc.strerror or exc}); choose a writable directory") from None
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fig.savefig(fh, format=ext, dpi=dpi, bbox_inches="tight")
-        # mkstemp creates the file with mode 0600; give it the mode a plain open() would
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException as exc:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        if isinstance(exc, OSError):
-            raise BrdfkitError(f"{option} {path!r}: cannot write the file "
-                               f"({exc.strerror or exc})") from None
-        raise
-    return path
+    return _io.write_atomic(
+        path, lambda fh: fig.savefig(fh, format=ext, dpi=dpi, bbox_inches="tight"),
+        option=option)
