@@ -178,10 +178,11 @@ class Microfacet(BRDF):
     name          default     bounds        meaning
     ============  ==========  ============  ==========================================
     distribution  beckmann    beckmann/ggx  microfacet normal distribution
-    alpha         0.1         (0, 4]        roughness (RMS slope for Beckmann);
+    alpha         0.1         [1e-8, 4]     roughness (RMS slope for Beckmann);
                                             0.01 near-mirror, 0.1 glossy, 0.5 rough
     eta           None        (0, 100]      real index (per channel); None: F = 1
-    k             0           [0, 100]      extinction (per channel); 0: dielectric
+    k             0           [0, 100]      extinction (per channel); 0: dielectric;
+                                            needs eta
     rho_s         1           [0, 1]        specular scale (per channel)
     ============  ==========  ============  ==========================================
 
@@ -200,8 +201,13 @@ class Microfacet(BRDF):
     params = (
         Param("distribution", "beckmann", kind="choice", choices=("beckmann", "ggx"),
               doc="microfacet normal distribution"),
-        Param("alpha", 0.1, 0.0, 4.0, "", "roughness: 0.01 near-mirror, 0.1 glossy, 0.5 rough",
-              lower_open=True),
+        # lower bound 1e-8: verified there (GGX and Beckmann) that the albedo engine gives
+        # a(0°) = a(45°) = a(80°) = 1 ± 1e-9 with F = 1 (the Smith G₁ of a near-mirror is
+        # 1 − O(α²)); at 1e-12 the lobe is narrower than it resolves, and below ~1e-154
+        # the peak 1/(πα²) overflows. Mitsuba clamps α at 1e-4.
+        Param("alpha", 0.1, 1e-8, 4.0, "",
+              "roughness: 0.01 near-mirror, 0.1 glossy, 0.5 rough (>= 1e-8: narrower lobes "
+              "are not resolved by the albedo engine)"),
         Param("eta", None, 0.0, 100.0, "", "real part of the index of refraction; none: F = 1",
               kind="colour", lower_open=True, optional=True),
         Param("k", 0.0, 0.0, 100.0, "", "extinction coefficient (conductors)", kind="colour"),
@@ -314,7 +320,12 @@ def _torrance_sparrow(ix, iy, iz, ox, oy, oz, p):
         alpha = math.acos(min(hz, 1.0))  # clamp: rounding can give hz slightly > 1
         d = b * math.exp(-(c * alpha) ** 2)  # D₂
     elif dist == TR_D:
-        q = c * c / (hz * hz * (c * c - 1.0) + 1.0)  # D₃; denominator ≥ min(c², 1) > 0
+        # D₃ with cos²α(c² − 1) + 1 = c² cos²α + sin²α, sin²α from H's components (no
+        # 1 − cos²α); the denominator is ≥ min(c², 1) > 0 unless c² underflows (c < 1e-154)
+        # at the exact bisector, where q = 1, its value for every c (the peak b of D₃)
+        c2 = c * c
+        den = c2 * (hz * hz) + (hx * hx + hy * hy)
+        q = c2 / den if den > 0.0 else 1.0
         d = b * q * q
     else:
         d = 0.25 * beckmann_lobe(hz, m) / (m * m)  # D₄ = e^{−tan²α/m²}/(4m² cos⁴α), no b
