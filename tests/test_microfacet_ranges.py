@@ -152,7 +152,8 @@ def test_finite_at_bounds_horizon_and_below(name, params):
 @pytest.mark.parametrize("name", ["microfacet", "modified-phong", "cook-torrance"])
 def test_non_unit_directions_are_refused(name):
     m = brdfkit.model(name)
-    with pytest.raises(BrdfkitError, match=r"wi must hold unit vectors.*0\.001 of 1.*norm 2 .*normalise"):
+    msg = r"wi must hold unit vectors.*0\.001 of 1.*norm 2 .*normalise"
+    with pytest.raises(BrdfkitError, match=msg):
         m.eval([0.0, 0.0, 2.0], [0.0, 0.0, 1.0])
     good = np.tile([0.0, 0.6, 0.8], (40, 1))
     bad = good.copy()
