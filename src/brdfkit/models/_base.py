@@ -28,10 +28,11 @@ Public objects
 - :class:`BRDF` — the base class of all models; it declares the model protocol.
 - :class:`DerivedBRDF` — the one constructor path for models built from others.
 - :func:`eval_pairs` — the compiled driver (for code that has packed arrays).
-- :func:`eval_pairs_checked` — the same, also testing the directions for NaN/inf
-  in the same pass (what :meth:`BRDF.eval` uses).
+- :func:`eval_pairs_checked` — the same, also testing in the same pass that the
+  directions are finite unit vectors (what :meth:`BRDF.eval` uses).
 - :func:`checked_driver` — :func:`eval_pairs_checked` compiled for one kernel,
-  inlined (for composite kernels such as pumped models').
+  inlined (composite kernels such as pumped models'; with ``vectorise=True``
+  the vectorised loop of branch-free kernels such as the microfacet models').
 """
 
 from __future__ import annotations
@@ -210,7 +211,34 @@ def eval_pairs(kernel, wi, wo, P, out):  # pragma: no cover - compiled
                                    P[c])
 
 
-def checked_driver(kernel):
+# Directions must be unit vectors: |‖w‖² − 1| ≤ UNIT_TOL, tested in the compiled pass (the
+# same read of the data as the NaN/inf test, which it subsumes: comparisons with NaN are
+# false and ‖w‖² of an infinite component is inf). 1e-3 on the squared norm (5e-4 on the
+# norm): directions normalised in float32 (within ~4e-7) and vectors typed with three or
+# four digits, such as (0.2, 0, −0.98) with ‖w‖² = 1.0004, pass; a vector scaled by mistake
+# (‖w‖ = 2), an unnormalised sum or difference of directions, or a half-converted angle
+# does not. The check guards against mistakes, not rounding: the kernels take the
+# components as given.
+UNIT_TOL = 1e-3
+
+
+@numba.njit(inline="always")
+def _unit_pair(ix, iy, iz, ox, oy, oz) -> bool:
+    """Both directions finite with |‖w‖² − 1| ≤ UNIT_TOL (False for NaN or inf)."""
+    return ((abs(ix * ix + iy * iy + iz * iz - 1.0) <= UNIT_TOL)
+            & (abs(ox * ox + oy * oy + oz * oz - 1.0) <= UNIT_TOL))
+
+
+# Compile options of the vectorising drivers (checked_driver(..., vectorise=True)): a kernel
+# inlined into them is compiled with the driver's options, so these are the kernel's.
+# error_model="numpy": IEEE division (no zero-divisor test, which would be a branch);
+# fastmath "contract" only: a·b + c may be one fused multiply-add; nothing that assumes
+# finite or non-NaN values.
+VECTOR_OPTIONS = {"error_model": "numpy", "fastmath": {"contract"}}
+_CHUNK = 4096  # pairs per task of the vectorised drivers (96 KiB of directions)
+
+
+def checked_driver(kernel, *, vectorise: bool = False):
     """:func:`eval_pairs_checked` specialised to one *kernel* (a new compiled function).
 
     :func:`eval_pairs_checked` calls its kernel through a first-class function
@@ -221,12 +249,69 @@ def checked_driver(kernel):
     loop when it is declared ``inline="always"``. Measured on 10 M pairs: a
     pumped Phong at the base model's speed instead of 1.2-1.6x slower. A model
     opts in by setting its ``_driver`` attribute (see :meth:`BRDF.eval`).
+
+    ``vectorise=True`` is for kernels written branch-free and *total*: for any
+    input values (NaN, inf, non-unit) they return without side effects and
+    read memory only in bounds (see :mod:`brdfkit._kern`). The driver then
+    evaluates every pair and selects NaN for the rejected ones instead of
+    branching around the kernel, so that LLVM vectorises the loop (4 float64
+    lanes with AVX2), and is compiled with :data:`VECTOR_OPTIONS`. The
+    directions are read as flat arrays (index 3j + k), which LLVM loads as
+    interleaved groups; measured on 10 M pairs (microfacet, Beckmann α = 0.1):
+    2.3x the generic loop on one thread.
     """
 
     # eval_pairs_checked's loop written out again on purpose: with one shared
     # inline="always" body called from both, the kernel became a variable of the inlined
     # body instead of this closure's and was no longer inlined (measured on 10 M pairs:
     # 4-20 % slower, as slow as the generic loop).
+    if vectorise:
+        @numba.njit(**VECTOR_OPTIONS)
+        def chunk(a, b, o, p):  # pragma: no cover - compiled
+            # One channel of the pairs in a and b (flat, 3 per pair) into o; returns the
+            # number of good pairs. What LLVM needs to vectorise this loop, each measured:
+            # its own function (inside the prange body Numba keeps the loop's variables
+            # live after it), indices from 0 (a signed start needs the negative-index
+            # wraparound select, and the loads are no longer an interleaved group),
+            # a unit-stride store, and the count as int64(ok) (not a select of 0 and 1).
+            good = 0
+            for j in range(o.shape[0]):
+                ix, iy, iz = a[3 * j], a[3 * j + 1], a[3 * j + 2]
+                ox, oy, oz = b[3 * j], b[3 * j + 1], b[3 * j + 2]
+                ok = _unit_pair(ix, iy, iz, ox, oy, oz)
+                v = kernel(ix, iy, iz, ox, oy, oz, p)  # total: safe for any input
+                o[j] = v if ok else math.nan
+                good += numba.int64(ok)
+            return good
+
+        @numba.njit(parallel=True, **VECTOR_OPTIONS)
+        def vector_driver(wi, wo, P, out):  # pragma: no cover - compiled
+            n = wi.shape[0]
+            n_channels = P.shape[0]
+            a = wi.reshape(3 * n)
+            b = wo.reshape(3 * n)
+            n_chunks = (n + _CHUNK - 1) // _CHUNK
+            n_good = 0
+            if n_channels == 1:
+                o = out.reshape(n)
+                p = P[0]
+                for q in numba.prange(n_chunks):
+                    lo = q * _CHUNK
+                    hi = min(n, lo + _CHUNK)
+                    n_good += chunk(a[3 * lo:3 * hi], b[3 * lo:3 * hi], o[lo:hi], p)
+                return n - n_good
+            col = np.empty(n)  # one channel at a time, then strided into out
+            for c in range(n_channels):
+                p = P[c]
+                for q in numba.prange(n_chunks):
+                    lo = q * _CHUNK
+                    hi = min(n, lo + _CHUNK)
+                    n_good += chunk(a[3 * lo:3 * hi], b[3 * lo:3 * hi], col[lo:hi], p)
+                out[:, c] = col
+            return n - n_good // n_channels
+
+        return vector_driver
+
     @numba.njit(parallel=True)
     def driver(wi, wo, P, out):  # pragma: no cover - compiled
         n = wi.shape[0]
@@ -237,7 +322,7 @@ def checked_driver(kernel):
             for j in numba.prange(n):
                 ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
                 ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-                if _finite6(ix, iy, iz, ox, oy, oz):
+                if _unit_pair(ix, iy, iz, ox, oy, oz):
                     out[j, 0] = kernel(ix, iy, iz, ox, oy, oz, p)
                 else:
                     out[j, 0] = math.nan
@@ -246,7 +331,7 @@ def checked_driver(kernel):
             for j in numba.prange(n):
                 ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
                 ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-                ok = _finite6(ix, iy, iz, ox, oy, oz)
+                ok = _unit_pair(ix, iy, iz, ox, oy, oz)
                 for c in range(n_channels):
                     out[j, c] = kernel(ix, iy, iz, ox, oy, oz, P[c]) if ok else math.nan
                 if not ok:
@@ -256,17 +341,12 @@ def checked_driver(kernel):
     return driver
 
 
-@numba.njit(inline="always")
-def _finite6(a, b, c, d, e, f) -> bool:
-    # x − x is 0 for finite x and NaN for ±inf and NaN; the sum is 0 iff all six are finite
-    return (a - a) + (b - b) + (c - c) + (d - d) + (e - e) + (f - f) == 0.0
-
-
 @numba.njit(parallel=True)
 def eval_pairs_checked(kernel, wi, wo, P, out):  # pragma: no cover - compiled
-    """:func:`eval_pairs` that also tests the directions for NaN/inf in the same pass.
+    """:func:`eval_pairs` that also tests the directions in the same pass.
 
-    Pairs with a non-finite component are not passed to the kernel (their
+    Pairs with a non-finite component or a direction that is not a unit
+    vector (|‖w‖² − 1| > :data:`UNIT_TOL`) are not passed to the kernel (their
     ``out`` rows are NaN). Returns the number of such pairs, so that the
     caller can raise; reading the directions once instead of twice is what
     makes this faster than ``np.isfinite`` followed by :func:`eval_pairs`.
@@ -279,7 +359,7 @@ def eval_pairs_checked(kernel, wi, wo, P, out):  # pragma: no cover - compiled
         for j in numba.prange(n):
             ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
             ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-            if _finite6(ix, iy, iz, ox, oy, oz):
+            if _unit_pair(ix, iy, iz, ox, oy, oz):
                 out[j, 0] = kernel(ix, iy, iz, ox, oy, oz, p)
             else:
                 out[j, 0] = math.nan
@@ -288,7 +368,7 @@ def eval_pairs_checked(kernel, wi, wo, P, out):  # pragma: no cover - compiled
         for j in numba.prange(n):
             ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
             ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-            if _finite6(ix, iy, iz, ox, oy, oz):
+            if _unit_pair(ix, iy, iz, ox, oy, oz):
                 for c in range(n_channels):
                     out[j, c] = kernel(ix, iy, iz, ox, oy, oz, P[c])
             else:
@@ -578,17 +658,24 @@ class BRDF:
             0 below the horizon. A trailing channel axis when any colour
             parameter was given per channel.
         """
-        # finiteness is tested in the compiled pass (eval_pairs_checked): one read of the data
+        # finiteness and unit length are tested in the compiled pass: one read of the data
         wi_in, wo_in = wi, wo
         wi = as_directions(wi, "wi", check_finite=False)
         wo = as_directions(wo, "wo", check_finite=False)
-        shape = np.broadcast_shapes(wi.shape, wo.shape)[:-1]
-        if wi.shape[:-1] != shape or not wi.flags.c_contiguous:
+        try:
+            shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
+        except ValueError:
+            raise BrdfkitError(
+                f"wi and wo must broadcast against each other; got shapes {wi.shape} and "
+                f"{wo.shape}"
+            ) from None
+        # (N, 3) C-contiguous: a view when the input already is, else one copy
+        if wi.shape[:-1] != shape:
             wi = np.broadcast_to(wi, (*shape, 3))
-        if wo.shape[:-1] != shape or not wo.flags.c_contiguous:
+        if wo.shape[:-1] != shape:
             wo = np.broadcast_to(wo, (*shape, 3))
-        wi2 = np.ascontiguousarray(wi.reshape(-1, 3))
-        wo2 = np.ascontiguousarray(wo.reshape(-1, 3))
+        wi2 = np.ascontiguousarray(wi).reshape(-1, 3)
+        wo2 = np.ascontiguousarray(wo).reshape(-1, 3)
         out = np.empty((wi2.shape[0], self._packed.shape[0]))
         driver = self._driver
         n_bad = (driver(wi2, wo2, self._packed, out) if driver is not None
@@ -596,7 +683,16 @@ class BRDF:
         if n_bad:
             as_directions(wi_in, "wi")  # raises the usual BrdfkitError for NaN/inf
             as_directions(wo_in, "wo")
-            raise BrdfkitError("wi or wo contains NaN or infinite components")  # unreachable
+            for name, w in (("wi", wi2), ("wo", wo2)):
+                norm2 = np.einsum("ij,ij->i", w, w)
+                bad = np.flatnonzero(~(np.abs(norm2 - 1.0) <= UNIT_TOL))
+                if bad.size:
+                    raise BrdfkitError(
+                        f"{name} must hold unit vectors (squared norm within {UNIT_TOL:g} of 1); "
+                        f"got norm {math.sqrt(norm2[bad[0]]):.9g} at flat index {bad[0]} "
+                        f"({bad.size} of {norm2.size}): normalise your vectors"
+                    )
+            raise BrdfkitError("wi or wo is not a finite unit vector")  # unreachable
         if self.n_channels is None:
             return out[:, 0].reshape(shape)
         return out.reshape(*shape, self.n_channels)
