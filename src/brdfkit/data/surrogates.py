@@ -82,7 +82,7 @@ import numpy as np
 from brdfkit._kern import INV_PI, half
 from brdfkit.errors import ParameterError
 from brdfkit.fresnel import _fresnel_dielectric
-from brdfkit.models._base import DerivedBRDF, Lobe, _finite6
+from brdfkit.models._base import DerivedBRDF, Lobe, _unit_pair
 
 __all__ = ["SurrogateBRDF", "nbrdf_material", "npf_material", "abc_material", "sgd_material",
            "nbrdf_kernel", "nbrdf_driver", "npf_kernel", "npf_driver", "abc_kernel",
@@ -235,7 +235,7 @@ def nbrdf_driver(wi, wo, P, out):  # pragma: no cover - compiled
             j = j0 + t
             ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
             ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-            if not _finite6(ix, iy, iz, ox, oy, oz):
+            if not _unit_pair(ix, iy, iz, ox, oy, oz):
                 state[t] = 2
             elif iz <= 0.0 or oz <= 0.0:
                 state[t] = 1
@@ -356,7 +356,7 @@ def npf_driver(wi, wo, P, out):  # pragma: no cover - compiled
     for j in numba.prange(wi.shape[0]):
         ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
         ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-        ok = _finite6(ix, iy, iz, ox, oy, oz)
+        ok = _unit_pair(ix, iy, iz, ox, oy, oz)
         for c in range(P.shape[0]):
             out[j, c] = npf_kernel(ix, iy, iz, ox, oy, oz, P[c]) if ok else math.nan
         if not ok:
@@ -400,7 +400,7 @@ def abc_driver(wi, wo, P, out):  # pragma: no cover - compiled
     for j in numba.prange(wi.shape[0]):
         ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
         ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-        ok = _finite6(ix, iy, iz, ox, oy, oz)
+        ok = _unit_pair(ix, iy, iz, ox, oy, oz)
         for c in range(P.shape[0]):
             out[j, c] = abc_kernel(ix, iy, iz, ox, oy, oz, P[c]) if ok else math.nan
         if not ok:
@@ -460,7 +460,7 @@ def sgd_driver(wi, wo, P, out):  # pragma: no cover - compiled
     for j in numba.prange(wi.shape[0]):
         ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
         ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-        ok = _finite6(ix, iy, iz, ox, oy, oz)
+        ok = _unit_pair(ix, iy, iz, ox, oy, oz)
         for c in range(P.shape[0]):
             out[j, c] = sgd_kernel(ix, iy, iz, ox, oy, oz, P[c]) if ok else math.nan
         if not ok:

@@ -561,6 +561,11 @@ class BRDF:
         rows = [self._pack_channel(self.channel_values(c)) for c in range(self.n_channels or 1)]
         return np.ascontiguousarray(np.array(rows, dtype=np.float64))
 
+    def _driver_data(self) -> np.ndarray:
+        """What :meth:`eval` passes to :attr:`_driver` in place of the packed rows (default:
+        :attr:`packed`; a table model passes its table in the layout its driver reads)."""
+        return self._packed
+
     def lobes(self) -> list[Lobe]:
         """The lobes of this parameterisation (see :class:`Lobe`); default: one diffuse."""
         return [Lobe("diffuse", math.pi / 2)]
@@ -678,7 +683,7 @@ class BRDF:
         wo2 = np.ascontiguousarray(wo).reshape(-1, 3)
         out = np.empty((wi2.shape[0], self._packed.shape[0]))
         driver = self._driver
-        n_bad = (driver(wi2, wo2, self._packed, out) if driver is not None
+        n_bad = (driver(wi2, wo2, self._driver_data(), out) if driver is not None
                  else eval_pairs_checked(self.kernel, wi2, wo2, self._packed, out))
         if n_bad:
             as_directions(wi_in, "wi")  # raises the usual BrdfkitError for NaN/inf
