@@ -320,12 +320,10 @@ def _torrance_sparrow(ix, iy, iz, ox, oy, oz, p):
         alpha = math.acos(min(hz, 1.0))  # clamp: rounding can give hz slightly > 1
         d = b * math.exp(-(c * alpha) ** 2)  # D₂
     elif dist == TR_D:
-        # D₃ with cos²α(c² − 1) + 1 = c² cos²α + sin²α, sin²α from H's components (no
-        # 1 − cos²α); the denominator is ≥ min(c², 1) > 0 unless c² underflows (c < 1e-154)
-        # at the exact bisector, where q = 1, its value for every c (the peak b of D₃)
-        c2 = c * c
-        den = c2 * (hz * hz) + (hx * hx + hy * hy)
-        q = c2 / den if den > 0.0 else 1.0
+        # D₃; the denominator is ≥ min(c², 1) > 0 unless c² underflows (c < 1e-154) at the
+        # exact bisector, where q = 1 is the limit (D₃ peaks at b for every c)
+        den = hz * hz * (c * c - 1.0) + 1.0
+        q = c * c / den if den > 0.0 else 1.0
         d = b * q * q
     else:
         d = 0.25 * beckmann_lobe(hz, m) / (m * m)  # D₄ = e^{−tan²α/m²}/(4m² cos⁴α), no b
