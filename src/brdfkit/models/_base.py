@@ -232,9 +232,10 @@ def _unit_pair(ix, iy, iz, ox, oy, oz) -> bool:
 # Compile options of the vectorising drivers (checked_driver(..., vectorise=True)): a kernel
 # inlined into them is compiled with the driver's options, so these are the kernel's.
 # error_model="numpy": IEEE division (no zero-divisor test, which would be a branch);
-# fastmath "contract" only: a·b + c may be one fused multiply-add; nothing that assumes
-# finite or non-NaN values.
-VECTOR_OPTIONS = {"error_model": "numpy", "fastmath": {"contract"}}
+# no fastmath flags: not even "contract" (fused multiply-adds), which LLVM applies
+# differently in the vector body and the scalar remainder, so one pair's value depended on
+# its position in the array by an ulp (tests/test_registry_properties.py, broadcasting).
+VECTOR_OPTIONS = {"error_model": "numpy", "fastmath": set()}
 _CHUNK = 4096  # pairs per task of the vectorised drivers (96 KiB of directions)
 
 

@@ -80,6 +80,10 @@ _FAST = VECTOR_OPTIONS["fastmath"]
 
 
 # =========================================================================== Walter 2007
+_TWO_600 = 2.0 ** 600  # the exact rescaling of a short s = wi + wo (see _walter)
+_TWO_M600 = 2.0 ** -600
+
+
 @_jit
 def _walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
     """F D G₁(ω_i) G₁(ω_o)/(4 cos θ_i cos θ_o), Walter eq. (20): one basic block.
@@ -89,8 +93,8 @@ def _walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
     kernels below. Written with s = wi + wo: tan²θ_h = |s_xy|²/s_z², cos²θ_h =
     s_z²/|s|² and ω_i·h = ω_o·h = |s|/2 (unit vectors). When every component of s
     is below SMALL_LENGTH (both directions within 1e-140 of the horizon) their
-    squares underflow: s is first divided by its largest component (a select;
-    in the common case the factor is exactly 1).
+    squares underflow: s is first multiplied by 2^600 (a select; exact; in the
+    common case the factor is exactly 1).
     """
     alpha, eta, k, scale = p[1], p[2], p[3], p[4]  # all parameters read first (vectorises)
     inv_a2 = 1.0 / (alpha * alpha)
@@ -99,8 +103,10 @@ def _walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
     sy = iy + oy
     sz = iz + oz  # > 0 in live lanes
     small = sz < SMALL_LENGTH
-    m = max(max(abs(sx), abs(sy)), sz)  # > 0 in live lanes
-    r = 1.0 / m if small else 1.0  # exact 1 on the common path (no rounding added)
+    # scale s by 2^600 when short (exact: a power of two): s_z ≥ 5e-324 then becomes
+    # ≥ 2e-143, whose square is a normal number; SMALL_LENGTH·2^600 ≈ 4e40 cannot
+    # overflow when squared. (1/max|s_k| would overflow for a subnormal s.)
+    r = _TWO_600 if small else 1.0  # exact 1 on the common path (no rounding added)
     sx *= r
     sy *= r
     sz *= r
@@ -108,7 +114,7 @@ def _walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
     sz2 = sz * sz
     l2 = sxy2 + sz2
     if fresnel:
-        cos_d = 0.5 * math.sqrt(l2) * (m if small else 1.0)  # ω_i·h = |s|/2
+        cos_d = 0.5 * math.sqrt(l2) * (_TWO_M600 if small else 1.0)  # ω_i·h = |s|/2
         f = _fresnel_conductor(cos_d if live else 1.0, eta, k)  # 1.0: keep discarded lanes finite
     else:
         f = 1.0
