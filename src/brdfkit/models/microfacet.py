@@ -33,7 +33,6 @@ import math
 import numba
 import numpy as np
 
-from brdfkit._array import as_directions, as_uniform
 from brdfkit._kern import INV_PI, SMALL_LENGTH, below_horizon, half, pos_pow
 from brdfkit.errors import ParameterError
 from brdfkit.fresnel import _fresnel_conductor, _fresnel_dielectric
@@ -55,8 +54,6 @@ from brdfkit.models.microfacet_distributions import (  # noqa: F401 - re-exporte
     G1_TABLE,
     SQRT_PI,
     Beckmann,
-    PhongLobe,
-    _half_and_cos,
     _HalfVectorSampling,
     beckmann_dg_over_cos,
     beckmann_g1_of_a,
@@ -72,6 +69,7 @@ from brdfkit.models.microfacet_distributions import (  # noqa: F401 - re-exporte
     smith_g1_beckmann_exact,
     smith_g1_ggx,
 )
+from brdfkit.models.sampling import HalfVector, StrategySampled
 
 _jit = numba.njit(cache=True, inline="always")
 BECKMANN, GGX = 0, 1  # the packed index of the distribution choice
@@ -173,7 +171,7 @@ _WALTER_DRIVERS = {
 
 
 @register
-class Microfacet(BRDF):
+class Microfacet(StrategySampled, BRDF):
     """Rough conductor / dielectric reflection of Walter et al. (2007), eq. (20).
 
     f_r = F(ω_i·h) D(h) G₁(ω_i) G₁(ω_o) / (4 cos θ_i cos θ_o), separable Smith
@@ -263,22 +261,9 @@ class Microfacet(BRDF):
         """The NumPy distribution object (D, sampling, pdf) of this instance."""
         return distribution(self._values["distribution"], self._values["alpha"])
 
-    def sample(self, wo, u):
-        wo = as_directions(wo, "wo")
-        u = as_uniform(u)
-        h = self._distribution().sample(u)
-        h = np.broadcast_to(h, np.broadcast_shapes(h.shape, wo.shape))
-        cos_oh = np.sum(wo * h, axis=-1, keepdims=True)
-        wi = 2.0 * cos_oh * h - wo
-        return wi, self.pdf(wi, wo)
-
-    def pdf(self, wi, wo):
-        wi = as_directions(wi, "wi")
-        wo = as_directions(wo, "wo")
-        h, norm = _half_and_cos(wi, wo)
-        cos_oh = np.abs(np.sum(wo * h, axis=-1))
-        p = self._distribution().pdf(h) / (4.0 * np.where(cos_oh > 0.0, cos_oh, 1.0))
-        return np.where((wo[..., 2] > 0.0) & (norm > 0.0) & (cos_oh > 0.0), p, 0.0)
+    def _strategy(self, wo):
+        """Half vectors from D cos θ_h (Walter eqs. 28, 35), pdf D cos θ_h/(4|ω_o·h|)."""
+        return HalfVector(self._distribution(), fold=False)
 
 
 # =========================================================================== shared helpers

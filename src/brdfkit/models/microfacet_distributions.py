@@ -22,7 +22,7 @@ GGX / Trowbridge-Reitz (Walter eqs. 33-35; Lewis's D₃)
     cancellation for tiny α), :func:`smith_g1_ggx`, :func:`ggx_g1_over_cos`,
     :func:`ggx_lambda`, :class:`GGX`.
 Phong lobe (Lewis's D₁, a sampling proposal)
-    :class:`PhongLobe`.
+    :class:`~brdfkit.models.sampling.PowerHalf` (the "phong" distribution).
 
 Clamps are commented where they are. tan²θ_h is always formed from the
 components of s = ωi + ωo as |s_xy|²/s_z² (or from those of h), never as
@@ -37,9 +37,16 @@ import math
 import numba
 import numpy as np
 
-from brdfkit._array import as_directions, as_uniform, stack
+from brdfkit._array import stack
 from brdfkit._kern import exp_nonpos
-from brdfkit.geometry import sample_cosine_hemisphere
+from brdfkit.models.sampling import (
+    COSINE,
+    HalfVector,
+    HalfVectorDistribution,
+    Mixture,
+    PowerHalf,
+    StrategySampled,
+)
 
 _jit = numba.njit(cache=True, inline="always")
 SQRT_PI = math.sqrt(math.pi)
@@ -282,7 +289,7 @@ def _normal_from_tan2(tan2: np.ndarray, u1: np.ndarray) -> np.ndarray:
     return stack(sin_h * np.cos(phi), sin_h * np.sin(phi), cos_h)
 
 
-class Beckmann:
+class Beckmann(HalfVectorDistribution):
     """Beckmann distribution of width α (NumPy side): D, sampling of D cos θ_h, its pdf."""
 
     def __init__(self, alpha: float):
@@ -306,7 +313,7 @@ class Beckmann:
         return _normal_from_tan2(-self.alpha**2 * np.log1p(-u0), u[..., 1])
 
 
-class GGX:
+class GGX(HalfVectorDistribution):
     """GGX / Trowbridge-Reitz distribution of width α (NumPy side)."""
 
     def __init__(self, alpha: float):
@@ -329,24 +336,7 @@ class GGX:
         return _normal_from_tan2(self.alpha**2 * u0 / (1.0 - u0), u[..., 1])
 
 
-class PhongLobe:
-    """The normalised lobe (n + 1)/(2π) cosⁿθ_h (Lewis's D₁ shape; a sampling proposal)."""
-
-    def __init__(self, n: float):
-        self.n = float(n)
-
-    def pdf(self, h: np.ndarray) -> np.ndarray:
-        c = np.maximum(h[..., 2], 0.0)
-        return (self.n + 1.0) / (2.0 * np.pi) * c**self.n
-
-    def sample(self, u: np.ndarray) -> np.ndarray:
-        cos_h = u[..., 0] ** (1.0 / (self.n + 1.0))
-        sin_h = np.sqrt(np.maximum(0.0, 1.0 - cos_h * cos_h))  # clamp: rounding at cos_h = 1
-        phi = 2.0 * np.pi * u[..., 1]
-        return stack(sin_h * np.cos(phi), sin_h * np.sin(phi), cos_h)
-
-
-_DISTRIBUTIONS = {"beckmann": Beckmann, "ggx": GGX, "phong": PhongLobe}
+_DISTRIBUTIONS = {"beckmann": Beckmann, "ggx": GGX, "phong": PowerHalf}
 
 
 def distribution(kind: str, width: float):
@@ -365,52 +355,20 @@ def beckmann_lobe(cos_h: float, m: float) -> float:
     return math.exp(-(1.0 - c2) / (c2 * m * m)) / (c2 * c2)
 
 
-def _half_and_cos(wi: np.ndarray, wo: np.ndarray):
-    h = wi + wo
-    norm = np.linalg.norm(h, axis=-1)
-    h = h / np.where(norm > 0.0, norm, 1.0)[..., None]
-    return h, norm
-
-
-class _HalfVectorSampling:
+class _HalfVectorSampling(StrategySampled):
     """Mixture sampler: cosine (probability ``_p_diffuse``) + reflection about a half vector.
 
-    The pdf is the exact density of this mixture: p_d cos θ_i/π +
-    (1 − p_d) p_h(h)/(4 |wo·h|) (the Jacobian of wi = 2(wo·h)h − wo).
-    Subclasses define ``_half_lobe() -> (kind, width)`` and ``_p_diffuse()``.
+    The strategy ``Mixture([COSINE, HalfVector(D, fold=False)], [p_d, 1 − p_d])`` of
+    :mod:`brdfkit.models.sampling`: density p_d cos θ_i/π + (1 − p_d) p_h(h)/(4 |wo·h|)
+    (the Jacobian of wi = 2(wo·h)h − wo). Subclasses define ``_half_lobe() -> (kind,
+    width)`` and ``_p_diffuse()``.
     """
 
     def _p_diffuse(self) -> float:
         return 0.0
 
-    def sample(self, wo, u):
-        wo = as_directions(wo, "wo")
-        u = as_uniform(u)
+    def _strategy(self, wo):
         kind, width = self._half_lobe()
         p_d = self._p_diffuse()
-        shape = np.broadcast_shapes(wo.shape, u.shape[:-1] + (3,))
-        if p_d > 0.0:
-            first = u[..., 0] < p_d
-            u0 = np.where(first, u[..., 0] / p_d, (u[..., 0] - p_d) / (1.0 - p_d)) \
-                if p_d < 1.0 else u[..., 0]
-            u = np.stack([np.minimum(u0, 1.0), u[..., 1]], axis=-1)
-        h = np.broadcast_to(distribution(kind, width).sample(u), shape)
-        wo_b = np.broadcast_to(wo, shape)
-        wi = 2.0 * np.sum(wo_b * h, axis=-1, keepdims=True) * h - wo_b
-        if p_d > 0.0:
-            wi_d = np.broadcast_to(sample_cosine_hemisphere(u), shape)
-            wi = np.where(np.broadcast_to(first, shape[:-1])[..., None], wi_d, wi)
-        return wi, self.pdf(wi, wo)
-
-    def pdf(self, wi, wo):
-        wi = as_directions(wi, "wi")
-        wo = as_directions(wo, "wo")
-        kind, width = self._half_lobe()
-        p_d = self._p_diffuse()
-        h, norm = _half_and_cos(wi, wo)
-        cos_oh = np.abs(np.sum(wo * h, axis=-1))
-        p_spec = distribution(kind, width).pdf(h) / (4.0 * np.where(cos_oh > 0.0, cos_oh, 1.0))
-        p_spec = np.where((norm > 0.0) & (cos_oh > 0.0), p_spec, 0.0)
-        p = (1.0 - p_d) * p_spec + p_d * np.maximum(wi[..., 2], 0.0) / np.pi
-        return np.where(wo[..., 2] > 0.0, p, 0.0)
-
+        lobe = HalfVector(distribution(kind, width), fold=False)
+        return lobe if p_d <= 0.0 else Mixture([COSINE, lobe], [p_d, 1.0 - p_d])

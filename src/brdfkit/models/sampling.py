@@ -19,8 +19,9 @@ below the horizon; the BRDF is 0 there and the caller discards them):
 - :class:`HalfVector` — a half vector h drawn about the normal from a
   :class:`HalfVectorDistribution`, ω_i the mirror of ω_o about h; density
   p_h(h)/(4|ω_o·h|) (the Jacobian of ω_i = 2(ω_o·h)h − ω_o). Distributions:
-  :class:`PowerHalf` ((N·H)ⁿ, Blinn), :class:`BeckmannHalf` and
-  :class:`GGXHalf` (microfacet normals, Walter et al. 2007).
+  :class:`PowerHalf` ((N·H)ⁿ, Blinn) here; Beckmann and GGX are the
+  distribution objects of :mod:`brdfkit.models.microfacet_distributions`
+  (each holds D, its sampler and pdf; Walter et al. 2007).
 - :class:`Mixture` — Σ_k w_k p_k with weights that may depend on ω_o.
 
 :func:`phong_lobe` and :func:`blinn_lobe` build the lobe strategies (the
@@ -67,7 +68,7 @@ from brdfkit.geometry import (
 
 __all__ = [
     "Strategy", "Cosine", "COSINE", "CosPowerNormal", "CosPowerAxis", "HalfVector",
-    "HalfVectorDistribution", "PowerHalf", "BeckmannHalf", "GGXHalf", "Mixture",
+    "HalfVectorDistribution", "PowerHalf", "Mixture",
     "StrategySampled", "phong_lobe", "blinn_lobe", "sample_phong_lobe", "pdf_phong_lobe",
     "sample_blinn_lobe", "pdf_blinn_lobe", "diffuse_fraction", "split_uniform",
     "normalised_weights", "log_mixture_weights",
@@ -236,15 +237,17 @@ class CosPowerAxis(Strategy):
 class HalfVectorDistribution:
     """A density p_h of half vectors (microfacet normals) about the normal.
 
-    ``sample_h(u)`` returns unit vectors h (..., 3) in the upper hemisphere;
-    ``pdf_h(cos_h)`` is their solid-angle density as a function of cos θ_h
-    (0 for cos θ_h ≤ 0).
+    ``sample(u)`` returns unit vectors h (..., 3) in the upper hemisphere from
+    uniform numbers u (..., 2); ``pdf(h)`` is their solid-angle density at unit
+    vectors h (0 for h_z ≤ 0). Taking h itself (not cos θ_h) lets a
+    distribution form tan²θ_h = |h_xy|²/h_z² without cancellation near the
+    normal (the microfacet distributions do).
     """
 
-    def sample_h(self, u: np.ndarray) -> np.ndarray:
+    def sample(self, u: np.ndarray) -> np.ndarray:
         raise NotImplementedError
 
-    def pdf_h(self, cos_h: np.ndarray) -> np.ndarray:
+    def pdf(self, h: np.ndarray) -> np.ndarray:
         raise NotImplementedError
 
 
@@ -254,71 +257,14 @@ class PowerHalf(HalfVectorDistribution):
     def __init__(self, n: float):
         self.n = float(n)
 
-    def sample_h(self, u):
+    def sample(self, u):
         return sample_phong_lobe(_NORMAL, self.n, u)
 
-    def pdf_h(self, cos_h):
-        return pdf_phong_lobe(cos_h, self.n)
+    def pdf(self, h):
+        return pdf_phong_lobe(h[..., 2], self.n)
 
     def __repr__(self) -> str:
         return f"PowerHalf({self.n:g})"
-
-
-class BeckmannHalf(HalfVectorDistribution):
-    """D(h) cos θ_h for Beckmann's D: exp(−tan²θ_h/m²)/(π m² cos³θ_h).
-
-    tan²θ_h = −m² ln(1 − u₀) (Walter et al. eq. 28; Ward's half-vector
-    sampling as corrected by Walter 2005).
-    """
-
-    def __init__(self, m: float):
-        self.m = float(m)
-
-    def sample_h(self, u):
-        u0 = np.minimum(u[..., 0], 1.0 - 1e-16)  # clamp: u₀ = 1 maps to θ_h = 90°
-        cos_h = 1.0 / np.sqrt(1.0 - self.m * self.m * np.log1p(-u0))
-        return _about_normal(cos_h, u)
-
-    def pdf_h(self, cos_h):
-        # clamp: avoid 0-division where the density is 0 anyway (1e-100: c⁴ must not underflow)
-        c = np.clip(cos_h, 1e-100, 1.0)
-        c2 = c * c
-        with np.errstate(under="ignore"):
-            p = np.exp(-(1.0 - c2) / c2 / self.m**2) / (np.pi * self.m**2 * c2 * c)
-        return np.where(cos_h > 0.0, p, 0.0)
-
-    def __repr__(self) -> str:
-        return f"BeckmannHalf({self.m:g})"
-
-
-class GGXHalf(HalfVectorDistribution):
-    """D(h) cos θ_h for GGX (Trowbridge–Reitz): α²/(π cos³θ_h (α² + tan²θ_h)²).
-
-    tan²θ_h = α² u₀/(1 − u₀) (Walter et al. eq. 35).
-    """
-
-    def __init__(self, alpha: float):
-        self.alpha = float(alpha)
-
-    def sample_h(self, u):
-        u0 = np.minimum(u[..., 0], 1.0 - 1e-16)  # clamp: u₀ = 1 maps to θ_h = 90°
-        cos_h = 1.0 / np.sqrt(1.0 + self.alpha * self.alpha * u0 / (1.0 - u0))
-        return _about_normal(cos_h, u)
-
-    def pdf_h(self, cos_h):
-        c = np.clip(cos_h, 1e-100, 1.0)  # clamp: as in BeckmannHalf
-        c2 = c * c
-        t = self.alpha**2 * c2 + (1.0 - c2)
-        return np.where(cos_h > 0.0, self.alpha**2 * c / (np.pi * t * t), 0.0)
-
-    def __repr__(self) -> str:
-        return f"GGXHalf({self.alpha:g})"
-
-
-def _about_normal(cos_h: np.ndarray, u: np.ndarray) -> np.ndarray:
-    sin_h = np.sqrt(np.maximum(0.0, 1.0 - cos_h * cos_h))  # clamp: rounding at cos_h = 1
-    phi = 2.0 * np.pi * u[..., 1]
-    return stack(sin_h * np.cos(phi), sin_h * np.sin(phi), cos_h)
 
 
 class HalfVector(Strategy):
@@ -338,7 +284,7 @@ class HalfVector(Strategy):
         self.fold = bool(fold)
 
     def sample(self, wo, u):
-        h = self.distribution.sample_h(u)
+        h = self.distribution.sample(u)
         h = np.broadcast_to(h, np.broadcast_shapes(h.shape, wo.shape))
         return 2.0 * np.sum(wo * h, axis=-1, keepdims=True) * h - wo
 
@@ -352,7 +298,7 @@ class HalfVector(Strategy):
             h = np.where(h[..., 2:3] < 0.0, -h, h)
         cos_oh = np.abs(np.sum(wo * h, axis=-1))
         ok &= cos_oh > 0.0
-        p = self.distribution.pdf_h(h[..., 2]) / (4.0 * np.where(ok, cos_oh, 1.0))
+        p = self.distribution.pdf(h) / (4.0 * np.where(ok, cos_oh, 1.0))
         return np.where(ok, p, 0.0)
 
     def __repr__(self) -> str:
