@@ -231,10 +231,12 @@ def _unit_pair(ix, iy, iz, ox, oy, oz) -> bool:
 
 # Compile options of the vectorising drivers (checked_driver(..., vectorise=True)): a kernel
 # inlined into them is compiled with the driver's options, so these are the kernel's.
-# error_model="numpy": IEEE division (no zero-divisor test, which would be a branch);
-# fastmath "contract" only: a·b + c may be one fused multiply-add; nothing that assumes
-# finite or non-NaN values.
-VECTOR_OPTIONS = {"error_model": "numpy", "fastmath": {"contract"}}
+# error_model="numpy": IEEE division (no zero-divisor test, which would be a branch).
+# No fastmath flag at all, not even "contract": LLVM contracts a·b + c into a fused
+# multiply-add differently in the vector body and in the scalar remainder of the loop, so
+# the same pair gave results differing in the last bit depending on its position
+# (test_registry_properties::test_broadcasting_shapes); without it every lane is IEEE.
+VECTOR_OPTIONS = {"error_model": "numpy"}
 _CHUNK = 4096  # pairs per task of the vectorised drivers (96 KiB of directions)
 
 

@@ -75,8 +75,9 @@ from brdfkit.models.microfacet_distributions import (  # noqa: F401 - re-exporte
 
 _jit = numba.njit(cache=True, inline="always")
 BECKMANN, GGX = 0, 1  # the packed index of the distribution choice
-# Compile options of the scalar (non-vectorised) fast kernels: as VECTOR_OPTIONS.
-_FAST = VECTOR_OPTIONS["fastmath"]
+# Compile options of cook-torrance's scalar fast kernel: IEEE division and FMA contraction.
+_FAST = {"contract"}
+_TWO_600 = 2.0**600
 
 
 # =========================================================================== Walter 2007
@@ -100,10 +101,13 @@ def _walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
     sz = iz + oz  # > 0 in live lanes
     small = sz < SMALL_LENGTH
     m = max(max(abs(sx), abs(sy)), sz)  # > 0 in live lanes
-    r = 1.0 / m if small else 1.0  # exact 1 on the common path (no rounding added)
-    sx *= r
-    sy *= r
-    sz *= r
+    # s/m as (s·r)·2^600 with r = 1/(m·2^600): 1/m itself overflows for a subnormal m;
+    # both factors are exactly 1 on the common path (no rounding added)
+    r = 1.0 / (m * _TWO_600) if small else 1.0
+    t = _TWO_600 if small else 1.0
+    sx = (sx * r) * t
+    sy = (sy * r) * t
+    sz = (sz * r) * t
     sxy2 = sx * sx + sy * sy
     sz2 = sz * sz
     l2 = sxy2 + sz2
