@@ -264,9 +264,11 @@ NEAREST, LINEAR = 0, 1
 
 
 @numba.njit(cache=True, inline="always")
-def _linear(p, theta_h, theta_d, phi_d):
-    """Trilinear interpolation between bin centres; NaN (unmeasured) neighbours are left
-    out and the weights of the others renormalised; NaN when all eight are unmeasured."""
+def _linear(t, stride, offset, theta_h, theta_d, phi_d):
+    """Trilinear interpolation between bin centres of the table whose bin i is
+    ``t[offset + stride·i]`` (a planar row: stride 1; the channel-interleaved table: stride
+    C). NaN (unmeasured) neighbours are left out and the weights of the others
+    renormalised; NaN when all eight are unmeasured."""
     uh = math.sqrt(max(theta_h, 0.0) / (0.5 * math.pi)) * 90.0 - 0.5
     ud = theta_d / (0.5 * math.pi) * 90.0 - 0.5
     if phi_d < 0.0:
@@ -291,7 +293,7 @@ def _linear(p, theta_h, theta_d, phi_d):
             for c in range(2):
                 wc = tp if c == 1 else 1.0 - tp
                 w = wa * wb * wc
-                v = p[_TABLE + (p0 + c) % 180 + 180 * (d0 + b) + 16200 * (h0 + a)]
+                v = t[offset + stride * ((p0 + c) % 180 + 180 * (d0 + b) + 16200 * (h0 + a))]
                 if v == v and w > 0.0:  # v == v: not NaN (an unmeasured bin)
                     acc += w * v
                     wsum += w
@@ -306,7 +308,7 @@ def _measured_kernel(ix, iy, iz, ox, oy, oz, p):
         return 0.0
     theta_h, theta_d, phi_d = _half_diff(ix, iy, iz, ox, oy, oz)
     if p[0] == LINEAR:
-        return _linear(p, theta_h, theta_d, phi_d)
+        return _linear(p, 1, _TABLE, theta_h, theta_d, phi_d)
     return p[_TABLE + _nearest_index(theta_h, theta_d, phi_d)]
 
 
@@ -321,6 +323,7 @@ def _measured_driver(wi, wo, T, out):  # pragma: no cover - compiled
     n = wi.shape[0]
     n_channels = T.shape[1]
     linear = T[0, 0] == LINEAR
+    flat = T.reshape(T.size)  # bin i, channel c at flat[C·(1 + i) + c]
     n_bad = 0
     for j in numba.prange(n):
         ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
@@ -336,47 +339,13 @@ def _measured_driver(wi, wo, T, out):  # pragma: no cover - compiled
             theta_h, theta_d, phi_d = _half_diff(ix, iy, iz, ox, oy, oz)
             if linear:
                 for c in range(n_channels):
-                    out[j, c] = _linear_interleaved(T, c, theta_h, theta_d, phi_d)
+                    out[j, c] = _linear(flat, n_channels, n_channels + c, theta_h, theta_d,
+                                        phi_d)
             else:
                 k = 1 + _nearest_index(theta_h, theta_d, phi_d)
                 for c in range(n_channels):
                     out[j, c] = T[k, c]
     return n_bad
-
-
-@numba.njit(cache=True, inline="always")
-def _linear_interleaved(T, ch, theta_h, theta_d, phi_d):
-    """:func:`_linear` on the interleaved table (same weights, same NaN rule)."""
-    uh = math.sqrt(max(theta_h, 0.0) / (0.5 * math.pi)) * 90.0 - 0.5
-    ud = theta_d / (0.5 * math.pi) * 90.0 - 0.5
-    if phi_d < 0.0:
-        phi_d += math.pi
-    up = phi_d / math.pi * 180.0 - 0.5
-    uh = min(max(uh, 0.0), 89.0)
-    ud = min(max(ud, 0.0), 89.0)
-    h0 = min(int(uh), 88)
-    d0 = min(int(ud), 88)
-    fp = math.floor(up)
-    p0 = int(fp) % 180
-    th = uh - h0
-    td = ud - d0
-    tp = up - fp
-    acc = 0.0
-    wsum = 0.0
-    for a in range(2):
-        wa = th if a == 1 else 1.0 - th
-        for b in range(2):
-            wb = td if b == 1 else 1.0 - td
-            for c in range(2):
-                wc = tp if c == 1 else 1.0 - tp
-                w = wa * wb * wc
-                v = T[1 + (p0 + c) % 180 + 180 * (d0 + b) + 16200 * (h0 + a), ch]
-                if v == v and w > 0.0:  # v == v: not NaN (an unmeasured bin)
-                    acc += w * v
-                    wsum += w
-    if wsum <= 0.0:
-        return math.nan
-    return acc / wsum
 
 
 # --------------------------------------------------------------------------- tabulation
