@@ -98,7 +98,7 @@ def _albedo_normal_incidence(m, alpha, n_t=4000, n_phi=4):
 
 
 @pytest.mark.parametrize("dist", ["beckmann", "ggx"])
-@pytest.mark.parametrize("alpha", [1e-2, 1e-4, 1e-6, 1e-8])
+@pytest.mark.parametrize("alpha", [1e-2, 1e-8])  # a glossy value and the lower bound (CI time)
 def test_near_mirror_albedo_at_normal_incidence_is_one(dist, alpha):
     # the half-vector's tan²θ_h is formed from the components of ωi + ωo: with
     # (1 − cos²)/cos² the GGX albedo at α = 1e-8 was 2.10
@@ -178,10 +178,9 @@ def test_non_broadcasting_shapes_name_both():
 
 
 # --------------------------------------------------------------------------- vectorised driver
-@pytest.mark.parametrize("params", [
-    {}, {"alpha": 0.01}, {"distribution": "ggx", "alpha": 0.3},
-    {"eta": 1.5}, {"distribution": "ggx", "eta": [0.2, 0.9, 1.1], "k": [3.9, 2.4, 2.2]},
-    {"rho_s": [1.0, 0.5]},
+@pytest.mark.parametrize("params", [  # each of the four kernels once (CI time)
+    {}, {"distribution": "ggx", "alpha": 0.3}, {"eta": 1.5},
+    {"distribution": "ggx", "eta": [0.2, 0.9, 1.1], "k": [3.9, 2.4, 2.2]},
 ])
 def test_vectorised_driver_equals_generic_loop(params):
     m = brdfkit.model("microfacet", **params)
