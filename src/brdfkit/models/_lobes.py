@@ -29,7 +29,8 @@ import numpy as np
 
 from brdfkit.halfangle import beta_from_exponent, exponent_from_beta
 from brdfkit.models._base import BRDF, Lobe, Param
-from brdfkit.models.sampling import StrategySampled
+from brdfkit.models.sampling import COSINE, Mixture, StrategySampled, blinn_lobe, normalised_weights
+from brdfkit.models.specular import blinn_normal_albedo
 
 __all__ = ["COS_DIVISOR_FLOOR", "CosineLobeBRDF", "lobe_pow"]
 
@@ -101,3 +102,21 @@ class CosineLobeBRDF(StrategySampled, BRDF):
     def width_from_beta(cls, beta: float) -> float:
         """Exponent with cosⁿβ = 1/2 (Lewis §3.1): ``n``, or ``s`` in ``nielsen``."""
         return float(exponent_from_beta(beta))
+
+
+class KdKsBlinnBRDF(CosineLobeBRDF):
+    """Base of the k_d + k_s (N·H)ⁿ models (``blinn``, ``phong-blinn-reciprocal``): their
+    lobes (a diffuse one where k_d > 0 and the N·H lobe) and their sampler, the cosine and
+    the N·H lobe mixed in proportion to their normal-incidence albedos πk_d and
+    k_s ∫(N·H)ⁿ cos θ_o dω_o (:func:`blinn_normal_albedo`)."""
+
+    def lobes(self):
+        out = [Lobe("diffuse", math.pi / 2)] if np.any(self._values["k_d"]) else []
+        return out + [lobe_hint("half", self._values["n"])]
+
+    def _strategy(self, wo):
+        v = self._values
+        n = v["n"]
+        w = normalised_weights([math.pi * channel_mean(v["k_d"]),
+                                channel_mean(v["k_s"]) * blinn_normal_albedo(n)])
+        return Mixture([COSINE, blinn_lobe(n)], w)

@@ -43,7 +43,7 @@ from brdfkit.models._lobes import (
     RHO_D,
     RHO_S,
     CosineLobeBRDF,
-    channel_mean,
+    KdKsBlinnBRDF,
     lobe_hint,
     lobe_pow,
 )
@@ -69,7 +69,7 @@ def _phong_blinn_reciprocal(ix, iy, iz, ox, oy, oz, p):
 
 
 @register
-class PhongBlinnReciprocal(CosineLobeBRDF):
+class PhongBlinnReciprocal(KdKsBlinnBRDF):
     """Lewis's reciprocal Phong–Blinn shader, eq. (24); Neumann's reciprocal Blinn, eq. (6).
 
     f_r(S, V) = k_d + k_s (N·H)ⁿ: eq. (8) without the 1/(N·S) of the specular
@@ -101,17 +101,6 @@ class PhongBlinnReciprocal(CosineLobeBRDF):
         {"k_d": 0.0, "k_s": 400.0, "n": 10000.0},
         {"k_d": [0.05, 0.1, 0.15], "k_s": [1.0, 0.5, 0.25], "n": 3.0},
     )
-
-    def lobes(self):
-        out = [Lobe("diffuse", math.pi / 2)] if np.any(self._values["k_d"]) else []
-        return out + [lobe_hint("half", self._values["n"])]
-
-    def _strategy(self, wo):
-        v = self._values
-        n = v["n"]
-        w = normalised_weights([math.pi * channel_mean(v["k_d"]),
-                                channel_mean(v["k_s"]) * blinn_normal_albedo(n)])
-        return Mixture([COSINE, blinn_lobe(n)], w)
 
 
 # --------------------------------------------------------------------------- Lewis §7

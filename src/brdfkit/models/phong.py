@@ -68,6 +68,7 @@ from brdfkit.models._lobes import (
     RHO_D,
     RHO_S,
     CosineLobeBRDF,
+    KdKsBlinnBRDF,
     channel_mean,
     lobe_hint,
     lobe_pow,
@@ -268,7 +269,7 @@ def _blinn(ix, iy, iz, ox, oy, oz, p):
 
 
 @register
-class Blinn(CosineLobeBRDF):
+class Blinn(KdKsBlinnBRDF):
     """The Blinn shader as a BRDF: Lewis eqs. (6) and (8).
 
     f_r(S, V) = k_d + k_s (N·H)ⁿ/(N·S), H = (S + V)/|S + V|. Although F_s^B
@@ -303,17 +304,6 @@ class Blinn(CosineLobeBRDF):
         {"k_d": 0.0, "k_s": 400.0, "n": 10000.0},
         {"k_d": [0.05, 0.1, 0.15], "k_s": [1.0, 0.5, 0.25], "n": 3.0},
     )
-
-    def lobes(self):
-        out = [Lobe("diffuse", math.pi / 2)] if np.any(self._values["k_d"]) else []
-        return out + [lobe_hint("half", self._values["n"])]
-
-    def _strategy(self, wo):
-        v = self._values
-        n = v["n"]
-        w = normalised_weights([math.pi * channel_mean(v["k_d"]),
-                                channel_mean(v["k_s"]) * blinn_normal_albedo(n)])
-        return Mixture([COSINE, blinn_lobe(n)], w)
 
 
 # --------------------------------------------------------------------------- Lewis eq. (22)
