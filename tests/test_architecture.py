@@ -22,7 +22,7 @@ LAYER = {
     "tables": 0, "_io": 0,
     # the package root is the public facade (brdfkit.model resolves model names and
     # material specs): layer 2, so the data layer is below it and cli/figures above
-    "": 2, "models": 1,
+    "": 2, "_specs": 2, "models": 1,
     "analysis": 2, "data": 2,
     "pumping": 3, "fitting": 3, "render": 3,
     "figures": 4, "cli": 4, "report": 4, "explorer": 4, "__main__": 4,

@@ -36,7 +36,12 @@ Conventions (stated once, here)
 
 Public objects
 --------------
-- :func:`brdfkit.model` — build a registered model by name (the dispatcher).
+- :func:`brdfkit.model` — build a registered model by name, or a measured
+  material by its spec (``merl:nickel``, ``rgl:NAME``, ``nielsen:NAME``, a
+  ``.binary`` path): the one dispatcher (:mod:`brdfkit._specs`).
+- :func:`brdfkit.model_params` — the parameter declarations a spec accepts.
+- :func:`brdfkit.material` / :func:`brdfkit.materials` — the built-in
+  measured materials (:mod:`brdfkit.data`).
 - :data:`brdfkit.MODELS` — the registry: canonical name → model class.
 - :func:`brdfkit.model_names` — the canonical names.
 - :mod:`brdfkit.geometry`, :mod:`brdfkit.fresnel`, :mod:`brdfkit.halfangle`
@@ -53,8 +58,10 @@ References
   *Microfacet Models for Refraction through Rough Surfaces*, EGSR 2007.
 """
 
+from brdfkit._specs import model, model_params
+from brdfkit.data import material, materials
 from brdfkit.errors import BrdfkitError, ParameterError, UnknownModelError
-from brdfkit.models import BRDF, MODELS, Param, model, model_names
+from brdfkit.models import BRDF, MODELS, Param, model_names
 
 __all__ = [
     "BRDF",
@@ -63,8 +70,11 @@ __all__ = [
     "Param",
     "ParameterError",
     "UnknownModelError",
+    "material",
+    "materials",
     "model",
     "model_names",
+    "model_params",
 ]
 
 __version__ = "0.1.0"

@@ -33,8 +33,9 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-import brdfkit
 from brdfkit.analysis.plausibility import check
+from brdfkit.models import BRDF, MODELS, resolve
+from brdfkit.models import model as registered_model
 
 __all__ = ["LEWIS_ROWS", "NEUMANN_CLAIMS", "EXTRA_ROWS", "table2", "format_table",
            "format_markdown"]
@@ -151,8 +152,10 @@ def table2(*, models=None,
 
     Parameters
     ----------
-    models : iterable of str, keyword-only, optional
-        Restrict to these registered names (default: all).
+    models : iterable of str or BRDF, keyword-only, optional
+        Restrict to these registered names (default: all); model objects
+        (measured materials, pumped or fitted models) get a row each after
+        the registered ones, with no paper claim to compare.
     progress : callable, keyword-only, optional
         Called as ``progress(done, total, model_name)`` before each row is
         computed (``done`` rows of ``total`` are finished, *model_name* is
@@ -165,11 +168,13 @@ def table2(*, models=None,
         Each row is :meth:`Verdict.to_dict` plus ``row`` (label), ``paper``
         (the claims checked) and ``agrees_with_paper``.
     """
-    names = list(brdfkit.MODELS) if models is None else [brdfkit.models.resolve(n).name
-                                                         for n in models]
+    objects = [] if models is None else [m for m in models if isinstance(m, BRDF)]
+    names = list(MODELS) if models is None else [resolve(n).name
+                                                         for n in models
+                                                         if not isinstance(n, BRDF)]
     lewis_by_model = {r[1]: r for r in LEWIS_ROWS}
     extra = [(name, params, label) for name, params, label in EXTRA_ROWS if name in names]
-    total = len(names) + len(extra)
+    total = len(names) + len(extra) + len(objects)
 
     def report(done: int, name: str) -> None:
         if progress is not None:
@@ -178,7 +183,7 @@ def table2(*, models=None,
     rows = []
     for name in names:
         report(len(rows), name)
-        m = brdfkit.model(name)
+        m = registered_model(name)
         label = name
         lw = lewis_by_model.get(name)
         if lw is not None:
@@ -186,7 +191,10 @@ def table2(*, models=None,
         rows.append(_row(m, label, lw))
     for name, params, label in extra:
         report(len(rows), name)
-        rows.append(_row(brdfkit.model(name, **params), f"{name} [{label}]"))
+        rows.append(_row(registered_model(name, **params), f"{name} [{label}]"))
+    for m in objects:  # given model objects (measured materials, pumped models): no claims
+        report(len(rows), m.name)
+        rows.append(_row(m, m.name))
     report(len(rows), "")
     return rows
 

@@ -28,9 +28,10 @@ from collections.abc import Callable, Iterable, Mapping
 import click
 import numpy as np
 
+from brdfkit._specs import canonical_name, model_params
+from brdfkit._specs import model as build_spec
 from brdfkit.cli._group import EXIT_USAGE
 from brdfkit.errors import BrdfkitError, ParameterError
-from brdfkit.models import resolve
 from brdfkit.pumping import MAX_TIMES
 from brdfkit.pumping import pump as pump_model
 
@@ -67,8 +68,6 @@ PARAM_HELP = (
 
 
 # --------------------------------------------------------------------------- parameters
-def _param_decls(cls) -> dict:
-    return {p.name: p for p in cls.params}
 
 
 def _parse_number(text: str, name: str, model: str, bounds: str) -> float:
@@ -86,7 +85,8 @@ def parse_param_items(model_name: str, items: Iterable[str] | Mapping) -> dict:
     Parameters
     ----------
     model_name : str
-        A registered name or alias (raises :class:`~brdfkit.errors.UnknownModelError`).
+        A registered name or alias, or a material spec (``merl:nickel``, a
+        ``.binary`` path; raises :class:`~brdfkit.errors.UnknownModelError`).
     items : iterable of str, or mapping
         ``NAME=VALUE`` strings as typed on the command line. A mapping is
         taken as already parsed and returned as a dict (no unit conversion).
@@ -103,10 +103,10 @@ def parse_param_items(model_name: str, items: Iterable[str] | Mapping) -> dict:
     ParameterError
         Malformed item, repeated name or a value that is not a number.
     """
-    cls = resolve(model_name)
+    label = canonical_name(model_name)
     if isinstance(items, Mapping):
         return dict(items)
-    decls = _param_decls(cls)
+    decls = {p.name: p for p in model_params(model_name)}
     out: dict = {}
     for item in items:
         name, sep, text = str(item).partition("=")
@@ -116,12 +116,12 @@ def parse_param_items(model_name: str, items: Iterable[str] | Mapping) -> dict:
                 f"parameter must be given as NAME=VALUE (e.g. -p rho_d=0.5); got {item!r}"
             )
         if name in out:
-            raise ParameterError(f"{cls.name}: parameter {name!r} given twice")
+            raise ParameterError(f"{label}: parameter {name!r} given twice")
         if name == "beta":
-            deg = _parse_number(text, "beta", cls.name, " of degrees in (0, 90)")
+            deg = _parse_number(text, "beta", label, " of degrees in (0, 90)")
             if not 0.0 < deg < 90.0:
                 raise ParameterError(
-                    f"{cls.name}: parameter 'beta' (half-angle, degrees on the command line) "
+                    f"{label}: parameter 'beta' (half-angle, degrees on the command line) "
                     f"must lie in (0, 90); got {text}"
                 )
             out[name] = math.radians(deg)
@@ -136,10 +136,10 @@ def parse_param_items(model_name: str, items: Iterable[str] | Mapping) -> dict:
         elif p.kind == "choice":
             out[name] = text
         elif p.kind in ("colour", "lobes") and "," in text:
-            out[name] = [_parse_number(t.strip(), name, cls.name, bounds)
+            out[name] = [_parse_number(t.strip(), name, label, bounds)
                          for t in text.split(",")]
         else:
-            out[name] = _parse_number(text, name, cls.name, bounds)
+            out[name] = _parse_number(text, name, label, bounds)
     return out
 
 
@@ -162,7 +162,8 @@ def build_model(name: str, params: Iterable[str] | Mapping = (), pump: str | Non
     Parameters
     ----------
     name : str
-        Registered name or alias.
+        Registered name or alias, or a material spec (``merl:nickel``,
+        ``rgl:NAME``, ``nielsen:NAME``, a ``.binary`` path).
     params : iterable of ``NAME=VALUE`` str, or mapping
         See :func:`parse_param_items`.
     pump : {None, "max", "controlled"}
@@ -177,12 +178,11 @@ def build_model(name: str, params: Iterable[str] | Mapping = (), pump: str | Non
         Unknown model, bad parameter, *times* out of range, or *times*
         given without *pump* (it would be silently ignored).
     """
-    cls = resolve(name)
-    kwargs = parse_param_items(cls.name, params)
+    kwargs = parse_param_items(name, params)
     if pump is None and times is not None:
         raise BrdfkitError(f"--times {times} needs --pump max or --pump controlled (it says how "
                            "many times to pump); add --pump or drop --times")
-    m = cls(**kwargs)
+    m = build_spec(name, **kwargs)
     if pump is None:
         return m
     times = 1 if times is None else times

@@ -31,6 +31,7 @@ Public objects
 - :func:`material` — resolve a spec to a model.
 - :func:`materials` — the catalog: one :class:`MaterialInfo` per material.
 - :func:`material_names` — the built-in specs.
+- :func:`suggest_material_specs` — did-you-mean hints for a bare material name.
 - :func:`is_material_spec` — whether a string is a material spec (for the
   dispatcher that also resolves model names).
 - :func:`normal_albedo` — directional albedo at θ_i = 0 by a 1-D quadrature.
@@ -69,6 +70,7 @@ from brdfkit.data.surrogates import (
 from brdfkit.errors import DataFileError, UnknownModelError
 
 __all__ = ["MaterialInfo", "material", "materials", "material_names", "is_material_spec",
+           "suggest_material_specs",
            "normal_albedo", "data_file", "MATERIAL_SOURCES"]
 
 #: Material-spec prefixes (data sources).
@@ -244,8 +246,24 @@ def material(spec):
                 if close else "")
         raise UnknownModelError(
             f"material spec {spec!r}: no {source} material named {name.strip()!r}{hint}; "
-            f"{len(_names(source))} {source} materials, listed by brdfkit.data.materials()")
+            + (f"valid: {', '.join(_names(source))}" if len(_names(source)) <= 10 else
+               f"{len(_names(source))} {source} materials, listed by 'brdfkit materials' "
+               "(brdfkit.data.materials())"))
     return _build(source, canonical, rep)
+
+
+def suggest_material_specs(name: str, *, n: int = 2) -> list[str]:
+    """Built-in specs whose material name is close to *name* (a bare ``nickel`` →
+    ``merl:nickel``), best first; for did-you-mean hints of the model dispatcher."""
+    key = _key(str(name).partition("@")[0].rpartition(":")[2])
+    if not key:
+        return []
+    candidates = {}
+    for source in MATERIAL_SOURCES:
+        for k, canonical in _lookup(source).items():
+            candidates.setdefault(k, f"{source}:{canonical}")
+    close = difflib.get_close_matches(key, list(candidates), n=n, cutoff=0.75)
+    return list(dict.fromkeys(candidates[c] for c in close))
 
 
 def material_names(*, representations: bool = False) -> list[str]:

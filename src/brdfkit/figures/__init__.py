@@ -17,7 +17,8 @@ Layout (imports go downward only)
   ``neumann-fig7``) — plain figure functions; they import the library, never
   :mod:`brdfkit.figures`.
 - :mod:`~brdfkit.figures._registry` — :data:`FIGURES`, the explicit list of
-  name → function, and the functions that use it.
+  name → function, :data:`MODEL_FIGURES` (figures of given models, e.g.
+  ``slices`` in :mod:`~brdfkit.figures.models`), and the functions that use them.
 
 Public objects
 --------------
@@ -32,6 +33,7 @@ from __future__ import annotations
 
 from brdfkit.figures._registry import (
     FIGURES,
+    MODEL_FIGURES,
     figure_names,
     make_figure,
     resolve_figure,
@@ -39,5 +41,5 @@ from brdfkit.figures._registry import (
 )
 from brdfkit.figures._save import check_output_path, save_atomic
 
-__all__ = ["FIGURES", "make_figure", "save_figure", "figure_names", "resolve_figure",
-           "save_atomic", "check_output_path"]
+__all__ = ["FIGURES", "MODEL_FIGURES", "make_figure", "save_figure", "figure_names",
+           "resolve_figure", "save_atomic", "check_output_path"]

@@ -14,10 +14,12 @@ from types import MappingProxyType
 
 from brdfkit.errors import BrdfkitError
 from brdfkit.figures import lewis, neumann
+from brdfkit.figures import models as model_figures
 from brdfkit.figures import pumping as pumping_figures
 from brdfkit.figures._save import check_output_path, save_atomic
 
-__all__ = ["FIGURES", "figure_names", "resolve_figure", "make_figure", "save_figure"]
+__all__ = ["FIGURES", "MODEL_FIGURES", "figure_names", "resolve_figure", "make_figure",
+           "save_figure"]
 
 #: name → function returning a Matplotlib Figure (read-only: edit the list here).
 FIGURES: Mapping[str, Callable] = MappingProxyType({
@@ -33,37 +35,52 @@ FIGURES: Mapping[str, Callable] = MappingProxyType({
     "neumann-fig7": pumping_figures.neumann_fig7,
 })
 
+#: name → function of the models to draw (``f(*models)`` → Figure): figures of any model or
+#: material, given by the caller (the CLI's ``--model``/``--compare``).
+MODEL_FIGURES: Mapping[str, Callable] = MappingProxyType({
+    "slices": model_figures.model_slices,
+})
+
 
 def figure_names() -> list[str]:
-    """Registered figure names, sorted."""
-    return sorted(FIGURES)
+    """Registered figure names (paper figures and model figures), sorted."""
+    return sorted([*FIGURES, *MODEL_FIGURES])
 
 
 def resolve_figure(name: str) -> str:
     """The registered name for *name* (case and surrounding blanks ignored), or BrdfkitError."""
     key = str(name).strip().lower()
-    if key not in FIGURES:
+    if key not in FIGURES and key not in MODEL_FIGURES:
         raise BrdfkitError(f"unknown figure {name!r}; valid names: " + ", ".join(figure_names()))
     return key
 
 
-def make_figure(name: str):
-    """Build the figure *name* (a Matplotlib Figure)."""
-    return FIGURES[resolve_figure(name)]()
+def make_figure(name: str, models=()):
+    """Build the figure *name* (a Matplotlib Figure); *models* for :data:`MODEL_FIGURES`."""
+    key = resolve_figure(name)
+    if key in MODEL_FIGURES:
+        if not models:
+            raise BrdfkitError(f"figure {key} draws given models: pass at least one model "
+                               f"(the CLI's --model SPEC)")
+        return MODEL_FIGURES[key](*models)
+    if models:
+        raise BrdfkitError(f"figure {key} reproduces a paper figure with its own models; it "
+                           f"takes no model (figures that do: {', '.join(MODEL_FIGURES)})")
+    return FIGURES[key]()
 
 
-def save_figure(name: str, path, *, dpi: int = 150, option: str = "path") -> str:
+def save_figure(name: str, path, *, dpi: int = 150, option: str = "path", models=()) -> str:
     """Build figure *name* and write it to *path* (.png or .svg); return *path*.
 
     The name and the path are checked before the (possibly long) computation.
     *option* is how the caller names *path* in error messages (the CLI passes
-    ``"--out"``).
+    ``"--out"``). *models* are the models a :data:`MODEL_FIGURES` figure draws.
     """
     import matplotlib.pyplot as plt
 
-    key = resolve_figure(name)
+    resolve_figure(name)
     check_output_path(path, option=option)
-    fig = FIGURES[key]()
+    fig = make_figure(name, models)
     try:
         return save_atomic(fig, path, dpi=dpi, option=option)
     finally:

@@ -1,0 +1,98 @@
+"""
+Data commands: ``materials`` and ``export``
+===========================================
+
+- ``brdfkit materials [SPEC ...] [--representations] [--json]`` — the built-in
+  measured materials with source, licence and albedo estimate.
+- ``brdfkit export SPEC [-p ...] [--pump ...] --out FILE.binary`` — any model,
+  pumped model or material on the MERL grid, written atomically.
+
+Plain click commands; :mod:`brdfkit.cli` adds them to the ``brdfkit`` group.
+"""
+
+from __future__ import annotations
+
+import time
+
+import click
+
+from brdfkit._io import check_output_path
+from brdfkit.cli._common import build_model, emit_json, model_options
+from brdfkit.data import material, materials
+from brdfkit.data.catalog import MaterialInfo, normal_albedo
+from brdfkit.data.export import export_merl
+from brdfkit.errors import BrdfkitError
+
+__all__ = ["materials_cmd", "export_cmd"]
+
+
+def _info_of(spec: str) -> MaterialInfo:
+    """The catalog entry of one spec (the dispatcher's error for an unknown one)."""
+    m = material(spec)  # raises the did-you-mean error
+    for info in materials(representations=True):
+        if info.name == m.name:
+            return info
+    raise BrdfkitError(f"{spec!r} is not a built-in material (a .binary file has no catalog "
+                       "entry); 'brdfkit materials' lists the built-in ones")
+
+
+@click.command("materials")
+@click.argument("specs", nargs=-1, metavar="[SPEC]...")
+@click.option("--representations", is_flag=True,
+              help="Also list the NPF, ABC and SGD fits of the MERL materials (459 rows).")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print a JSON list of {name, source, material, representation, licence, "
+                   "citation, albedo, rho_d}.")
+def materials_cmd(specs, representations, as_json):
+    """List the built-in measured materials (or only SPEC ...).
+
+    159 materials: 100 MERL (NBRDF surrogate by default; @npf, @abc, @sgd
+    with --representations), 51 RGL-EPFL and 8 Nielsen et al. 2015. Each row
+    gives the spec to pass wherever a model name goes, the data source, the
+    licences and the albedo estimate a(0) per RGB channel (directional albedo
+    at normal incidence; for glossy materials it includes the specular
+    lobe). MERL data: Matusik et al. 2003, CC-BY-SA-4.0 — keep the
+    attribution in derived work.
+    """
+    rows = [_info_of(s) for s in specs] if specs else materials(representations=representations)
+    if as_json:
+        emit_json([r.to_dict() for r in rows])
+        return
+    width = max(len(r.name) for r in rows)
+    click.echo(f"{'spec'.ljust(width)}  {'a(0) R     G     B':19s}  licence")
+    for r in rows:
+        a = " ".join(f"{x:5.3f}" for x in r.albedo)
+        click.echo(f"{r.name.ljust(width)}  {a:19s}  {r.licence}")
+    if not specs:
+        click.echo(f"\n{len(rows)} materials; pass a spec wherever a model name goes "
+                   "(e.g. brdfkit eval merl:nickel --wi 30,0 --wo 30,180).")
+
+
+@click.command("export")
+@model_options
+@click.option("--out", "out", required=True, metavar="FILE.binary",
+              help="Output MERL .binary file (written atomically; the directory must exist).")
+@click.option("--json", "as_json", is_flag=True,
+              help='Print {"model", "params", "out", "seconds", "normal_albedo"}.')
+def export_cmd(model, param, pump, times, out, as_json):
+    """Write MODEL (a model, pumped model or material) onto the MERL grid as FILE.binary.
+
+    Each bin holds f_r at the centre of its index coordinates (theta_h =
+    ((i+1/2)/90)^2 * 90 deg, theta_d = (j+1/2) deg, phi_d = (k+1/2) deg,
+    phi_h = 0); bins with a direction at or below the horizon are written -1
+    (MERL's "not measured"). One-channel models are written grey. BRDF
+    Explorer, ALTA, bbm and Mitsuba pipelines read the file; 'brdfkit eval
+    FILE.binary ...' reads it back.
+    """
+    check_output_path(out, option="--out", suffixes=(".binary",))
+    m = build_model(model, param, pump=pump, times=times)
+    t0 = time.perf_counter()
+    path = export_merl(m, out)
+    seconds = time.perf_counter() - t0
+    if as_json:
+        d = m.to_dict()
+        emit_json({"model": d["model"], "params": d["params"],
+                   **({"pump": d["pump"]} if "pump" in d else {}), "out": path,
+                   "seconds": seconds, "normal_albedo": normal_albedo(material(path))})
+        return
+    click.echo(path)
