@@ -35,6 +35,22 @@ if [ ! -x .venv/bin/python ]; then
   "$py" -m venv .venv
 fi
 
+# System part: Mitsuba 3's llvm_* variants (rendering, the Mitsuba bridge and its tests) need
+# Debian's libllvm19 (LLVM 15/16 load but abort on microfacet kernels). Installed with apt when
+# running as root; otherwise brdfkit falls back to Mitsuba's scalar_* variants and says so.
+if [ -n "$extra" ] || [ "${BRDFKIT_SYSTEM_DEPS:-0}" = 1 ]; then
+  if ldconfig -p 2>/dev/null | grep -q 'libLLVM.so.19\|libLLVM-19'; then
+    :
+  elif [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+    echo "setup.sh: installing libllvm19 (apt) for Mitsuba's llvm_* variants"
+    apt-get install -y -q libllvm19 >/dev/null 2>&1 \
+      || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q libllvm19 >/dev/null; } \
+      || echo "setup.sh: warning: could not install libllvm19; Mitsuba renders fall back to scalar_* variants (slower)" >&2
+  else
+    echo "setup.sh: note: libllvm19 is missing and this is not root with apt-get; Mitsuba renders fall back to scalar_* variants (slower). Fix: sudo apt-get install libllvm19" >&2
+  fi
+fi
+
 .venv/bin/python -m pip install -q --upgrade pip
 .venv/bin/python -m pip install -q -e ".${extra}"
 .venv/bin/python -c "import brdfkit; print('setup.sh: brdfkit', brdfkit.__version__, 'ready in .venv/')"
