@@ -1,0 +1,36 @@
+"""
+``brdfkit explore``: the browser app
+====================================
+
+Plain click command; :mod:`brdfkit.cli` adds it to the ``brdfkit`` group.
+"""
+
+from __future__ import annotations
+
+import click
+
+from brdfkit.explorer.serve import DEFAULT_PORT, LOCALHOST, serve
+
+__all__ = ["explore_cmd"]
+
+
+@click.command("explore")
+@click.argument("specs", nargs=-1, metavar="[SPEC]...")
+@click.option("--port", type=click.IntRange(1, 65535), default=DEFAULT_PORT, show_default=True,
+              help="TCP port.")
+@click.option("--host", default=LOCALHOST, show_default=True,
+              help="Address to listen on. The default serves this machine only; give another "
+                   "address (e.g. 0.0.0.0) only to allow remote access on purpose.")
+@click.option("--no-browser", is_flag=True, help="Do not open a browser window.")
+def explore_cmd(specs, port, host, no_browser):
+    """Open the explorer: models, pumped models and materials side by side in a browser.
+
+    SPEC... are the models shown first (model names or material specs such as
+    merl:nickel); more can be added in the page. Views: in-plane polar plot,
+    3-D lobe, f against theta_h/theta_d/theta_o, theta_h x theta_d slice, the lit
+    sphere of Lewis's test configuration, and the albedo curve with the
+    plausibility verdict. Serves on 127.0.0.1 only unless --host is given;
+    Ctrl-C stops it.
+    """
+    serve(specs=specs, host=host, port=port, open_browser=not no_browser,
+          log=lambda s: click.echo(s, err=True))

@@ -1,0 +1,206 @@
+"""
+The explorer's web layer (FastAPI), thin over :mod:`brdfkit.explorer.views`
+============================================================================
+
+One page (``static/index.html`` + ``static/app.js``, plain JavaScript drawing on
+canvases: no CDN, the page works offline) and a JSON API:
+
+==========================  =================================================
+``GET  /``                  the page
+``GET  /api/catalog``       models (parameter declarations), materials
+``POST /api/views``         every view of every model for one state
+``POST /api/verdict``       plausibility verdicts (slower; fetched after)
+``POST /api/export/binary`` one model on the MERL grid (a ``.binary`` file)
+==========================  =================================================
+
+A state is ``{"models": [{"spec", "params", "pump", "times", "visible"}],
+"theta_i", "phi_i", "phi_l" (Φ_L of the sphere test, 0–180), "ambient" (angles
+in degrees, as on the command line), "mode": "luminance"|"rgb", "cosine": bool}``. A model that cannot be
+built (unknown spec, parameter out of bounds, unreadable file) comes back as
+``{"spec", "error"}`` and the page shows the message; the other models are
+drawn. Models are cached by their full description (a pumped model's tables
+are built once).
+
+Why FastAPI and not Panel: measured on this machine, one ``/api/views`` round
+trip for a model is dominated by the views themselves (see
+``benchmarks/bench_explorer.py``); FastAPI adds about a millisecond, needs no
+Bokeh document model, and the page stays plain HTML that Playwright drives
+directly (no shadow DOM).
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+import math
+import tempfile
+import time
+from collections import OrderedDict
+from importlib import resources
+from pathlib import Path
+
+from brdfkit._specs import model as build_spec
+from brdfkit.data import material_names
+from brdfkit.data.export import export_merl
+from brdfkit.errors import BrdfkitError
+from brdfkit.explorer import views
+from brdfkit.models import MODELS
+from brdfkit.pumping import MAX_TIMES, pump
+
+__all__ = ["create_app", "build_entry", "parse_state"]
+
+_CACHE_SIZE = 32
+
+
+def _number(state: dict, key: str, default: float, lo: float, hi: float) -> float:
+    v = state.get(key, default)
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        raise BrdfkitError(f"{key} must be a number in [{lo:g}, {hi:g}]; got {v!r}") from None
+    if not lo <= x <= hi:
+        raise BrdfkitError(f"{key} must lie in [{lo:g}, {hi:g}]; got {x:g}")
+    return x
+
+
+def parse_state(state: dict) -> dict:
+    """Validate a state (module docstring); angles converted to radians."""
+    if not isinstance(state, dict):
+        raise BrdfkitError("the request body must be a JSON object (the explorer state)")
+    models = state.get("models", [])
+    if not isinstance(models, list) or len(models) > 8:
+        raise BrdfkitError("models must be a list of at most 8 entries")
+    mode = state.get("mode", "luminance")
+    if mode not in ("luminance", "rgb"):
+        raise BrdfkitError(f"mode must be 'luminance' or 'rgb'; got {mode!r}")
+    return {
+        "models": models,
+        "theta_i": math.radians(_number(state, "theta_i", 30.0, 0.0, 89.5)),
+        "phi_i": math.radians(_number(state, "phi_i", 0.0, -360.0, 360.0)),
+        "phi_l": math.radians(_number(state, "phi_l", 30.0, 0.0, 180.0)),
+        "ambient": _number(state, "ambient", 0.0, 0.0, 10.0),
+        "mode": mode,
+        "cosine": bool(state.get("cosine", False)),
+    }
+
+
+def build_entry(entry: dict):
+    """A model from one state entry ``{"spec", "params", "pump", "times"}``."""
+    if not isinstance(entry, dict) or not isinstance(entry.get("spec"), str):
+        raise BrdfkitError("each model entry needs a 'spec' string (a model name or material)")
+    params = entry.get("params") or {}
+    if not isinstance(params, dict):
+        raise BrdfkitError(f"{entry['spec']}: params must be an object NAME: VALUE")
+    params = {k: v for k, v in params.items() if v is not None and v != ""}
+    if "beta" in params:  # degrees in the UI, as on the command line
+        params["beta"] = math.radians(float(params["beta"]))
+    m = build_spec(entry["spec"], **params)
+    g = entry.get("pump")
+    if g in (None, "", "none"):
+        return m
+    if g not in ("max", "controlled"):
+        raise BrdfkitError(f"pump must be 'max', 'controlled' or none; got {g!r}")
+    times = entry.get("times", 1)
+    if not (isinstance(times, int) and 1 <= times <= MAX_TIMES):
+        raise BrdfkitError(f"times must be an integer from 1 to {MAX_TIMES}; got {times!r}")
+    return pump(m, g=g, times=times)
+
+
+def _b64(png: bytes) -> str:
+    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
+
+
+def create_app():
+    """The FastAPI application (one model cache per app)."""
+    from fastapi import FastAPI, Request
+    from fastapi.responses import HTMLResponse, JSONResponse, Response
+
+    app = FastAPI(title="brdfkit explorer", docs_url=None, redoc_url=None)
+    cache: OrderedDict[str, object] = OrderedDict()
+    static = resources.files("brdfkit.explorer") / "static"
+
+    def get_model(entry: dict):
+        key = json.dumps({k: entry.get(k) for k in ("spec", "params", "pump", "times")},
+                         sort_keys=True)
+        if key not in cache:
+            cache[key] = build_entry(entry)
+            if len(cache) > _CACHE_SIZE:
+                cache.popitem(last=False)
+        cache.move_to_end(key)
+        return cache[key]
+
+    @app.exception_handler(BrdfkitError)
+    async def _brdfkit_error(request: Request, exc: BrdfkitError):
+        return JSONResponse({"error": str(exc)}, status_code=400)
+
+    @app.exception_handler(Exception)
+    async def _any_error(request: Request, exc: Exception):  # never a traceback in the page
+        return JSONResponse({"error": f"internal error: {type(exc).__name__}: {exc}"},
+                            status_code=500)
+
+    @app.get("/", response_class=HTMLResponse)
+    def index():
+        return (static / "index.html").read_text(encoding="utf-8")
+
+    @app.get("/static/{name}")
+    def static_file(name: str):
+        if name not in ("app.js", "style.css"):
+            return JSONResponse({"error": f"no such file {name!r}"}, status_code=404)
+        kind = "text/javascript" if name.endswith(".js") else "text/css"
+        return Response((static / name).read_text(encoding="utf-8"), media_type=kind)
+
+    @app.get("/api/catalog")
+    def catalog():
+        return {"models": [cls.describe() for cls in MODELS.values()],
+                "materials": material_names(representations=True), "max_times": MAX_TIMES}
+
+    @app.post("/api/views")
+    async def all_views(request: Request):
+        s = parse_state(await request.json())
+        t0 = time.perf_counter()
+        out = []
+        for entry in s["models"]:
+            try:
+                m = get_model(entry)
+                png_s, sph = views.sphere(m, phi_l=s["phi_l"], ambient=s["ambient"])
+                png_h, hd = views.halfdiff(m)
+                out.append({
+                    "spec": entry.get("spec"), "name": m.name, "params": m.to_dict()["params"],
+                    "polar": views.polar(m, s["theta_i"], s["phi_i"], cosine=s["cosine"],
+                                         mode=s["mode"]),
+                    "lobe": views.lobe(m, s["theta_i"], s["phi_i"]),
+                    "curves": views.curves(m, s["theta_i"], s["phi_i"], cosine=s["cosine"],
+                                           mode=s["mode"]),
+                    "albedo": views.albedo_curve(m, mode=s["mode"]),
+                    "sphere": _b64(png_s), "sphere_info": sph,
+                    "halfdiff": _b64(png_h), "halfdiff_info": hd,
+                    "reciprocal_claim": m.reciprocal,
+                })
+            except BrdfkitError as exc:
+                out.append({"spec": entry.get("spec"), "error": str(exc)})
+        return {"models": out, "ms": round(1e3 * (time.perf_counter() - t0), 1)}
+
+    @app.post("/api/verdict")
+    async def verdicts(request: Request):
+        s = parse_state(await request.json())
+        out = []
+        for entry in s["models"]:
+            try:
+                out.append(views.verdict(get_model(entry)))
+            except BrdfkitError as exc:
+                out.append({"spec": entry.get("spec"), "error": str(exc)})
+        return {"verdicts": out}
+
+    @app.post("/api/export/binary")
+    async def export_binary(request: Request):
+        entry = await request.json()
+        m = get_model(entry)
+        with tempfile.TemporaryDirectory() as d:
+            path = Path(d) / "model.binary"
+            export_merl(m, path)
+            data = path.read_bytes()
+        name = "".join(c if c.isalnum() or c in "-_." else "_" for c in m.name) + ".binary"
+        return Response(data, media_type="application/octet-stream",
+                        headers={"Content-Disposition": f'attachment; filename="{name}"'})
+
+    return app

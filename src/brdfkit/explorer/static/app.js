@@ -1,0 +1,492 @@
+// brdfkit explorer: plain JavaScript over the JSON API of brdfkit.explorer.app.
+// The state lives in the URL hash (a shared link reopens the same view).
+"use strict";
+
+const COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf"];
+const CHANNEL_DASH = [[], [6, 3], [2, 2]];
+let catalog = null;
+let state = null;
+let lastViews = null;
+let lobeView = { yaw: -0.6, pitch: 0.5 };
+let pending = null;
+let inflight = false;
+
+function defaultState() {
+  return { models: [{ spec: "modified-phong", params: {}, pump: null, times: 1, visible: true }],
+           theta_i: 30, phi_i: 0, phi_l: 30, ambient: 0, mode: "luminance", log: false,
+           cosine: false, solo: null };
+}
+
+function readHash() {
+  if (!location.hash || location.hash.length < 2) return defaultState();
+  try {
+    return Object.assign(defaultState(), JSON.parse(decodeURIComponent(location.hash.slice(1))));
+  } catch (e) {
+    showMessage("the link's state could not be read (" + e.message + "); showing the defaults");
+    return defaultState();
+  }
+}
+
+function writeHash() {
+  history.replaceState(null, "", "#" + encodeURIComponent(JSON.stringify(state)));
+}
+
+function showMessage(text) {
+  const el = document.getElementById("message");
+  if (!text) { el.hidden = true; el.textContent = ""; return; }
+  el.hidden = false;
+  el.textContent = text;
+}
+
+async function api(path, body) {
+  const res = await fetch(path, body === undefined ? {} : {
+    method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) });
+  const data = await res.json();
+  if (!res.ok) throw new Error(data.error || ("HTTP " + res.status));
+  return data;
+}
+
+// ------------------------------------------------------------------ model list and controls
+function declOf(spec) {
+  if (!catalog) return null;
+  const key = spec.trim().toLowerCase().replace(/_/g, "-");
+  return catalog.models.find(m => m.name === key || (m.aliases || []).includes(key)) || null;
+}
+
+function visibleEntries() {
+  return state.models.map((m, i) => [m, i]).filter(([m, i]) =>
+    state.solo === null ? m.visible !== false : state.solo === i);
+}
+
+function paramControl(entry, p) {
+  const label = document.createElement("label");
+  label.textContent = p.name + " ";
+  let input;
+  const current = entry.params[p.name];
+  if (p.kind === "choice") {
+    input = document.createElement("select");
+    for (const c of p.choices) {
+      const o = document.createElement("option");
+      o.value = c; o.textContent = c; input.appendChild(o);
+    }
+    input.value = current !== undefined ? current : p.default;
+  } else if (p.kind === "scalar") {
+    input = document.createElement("input");
+    input.type = "number"; input.step = "any";
+    input.value = current !== undefined ? current : (p.default === null ? "" : p.default);
+  } else {
+    input = document.createElement("input");
+    input.type = "text";
+    const v = current !== undefined ? current : p.default;
+    input.value = Array.isArray(v) ? v.join(",") : (v === null ? "" : v);
+  }
+  input.dataset.param = p.name;
+  input.title = (p.doc || "") + " bounds " + p.bounds + (p.unit ? " (" + p.unit + ")" : "");
+  input.addEventListener("change", () => {
+    const text = String(input.value).trim();
+    if (text === "") delete entry.params[p.name];
+    else if (p.kind === "choice") entry.params[p.name] = text;
+    else if (text.includes(",")) entry.params[p.name] = text.split(",").map(Number);
+    else entry.params[p.name] = Number(text);
+    update();
+  });
+  label.appendChild(input);
+  const hint = document.createElement("small");
+  hint.textContent = " " + p.bounds;
+  label.appendChild(hint);
+  return label;
+}
+
+function renderModelList() {
+  const list = document.getElementById("model-list");
+  list.innerHTML = "";
+  state.models.forEach((entry, i) => {
+    const box = document.createElement("div");
+    box.className = "model";
+    box.style.borderLeftColor = COLOURS[i % COLOURS.length];
+    const head = document.createElement("div");
+    const name = document.createElement("span");
+    name.className = "name"; name.textContent = entry.spec;
+    head.appendChild(name);
+    const vis = document.createElement("input");
+    vis.type = "checkbox"; vis.checked = entry.visible !== false; vis.title = "show";
+    vis.addEventListener("change", () => { entry.visible = vis.checked; update(); });
+    head.appendChild(vis);
+    const solo = document.createElement("button");
+    solo.textContent = state.solo === i ? "unsolo" : "solo";
+    solo.addEventListener("click", () => { state.solo = state.solo === i ? null : i; renderModelList(); update(); });
+    head.appendChild(solo);
+    const rm = document.createElement("button");
+    rm.textContent = "remove";
+    rm.addEventListener("click", () => { state.models.splice(i, 1); state.solo = null; renderModelList(); update(); });
+    head.appendChild(rm);
+    box.appendChild(head);
+    const decl = declOf(entry.spec);
+    if (decl) {
+      for (const p of decl.params) box.appendChild(paramControl(entry, p));
+      if (decl.beta) {
+        box.appendChild(paramControl(entry, { name: "beta", kind: "scalar", default: null,
+          bounds: "(0, 90) deg, sets " + decl.beta, unit: "deg", doc: "lobe half-angle" }));
+      }
+    }
+    const pumpLabel = document.createElement("label");
+    pumpLabel.textContent = "pump ";
+    const pump = document.createElement("select");
+    for (const v of ["none", "max", "controlled"]) {
+      const o = document.createElement("option"); o.value = v; o.textContent = v; pump.appendChild(o);
+    }
+    pump.value = entry.pump || "none";
+    pump.dataset.role = "pump";
+    pump.addEventListener("change", () => { entry.pump = pump.value === "none" ? null : pump.value; update(); });
+    pumpLabel.appendChild(pump);
+    const times = document.createElement("input");
+    times.type = "number"; times.min = 1; times.max = catalog ? catalog.max_times : 8;
+    times.value = entry.times || 1; times.style.width = "40px"; times.title = "times";
+    times.addEventListener("change", () => { entry.times = parseInt(times.value, 10); update(); });
+    pumpLabel.appendChild(document.createTextNode(" × "));
+    pumpLabel.appendChild(times);
+    box.appendChild(pumpLabel);
+    const err = document.createElement("div");
+    err.className = "error"; err.id = "model-error-" + i;
+    box.appendChild(err);
+    list.appendChild(box);
+  });
+}
+
+function bindGlobal(id, parse) {
+  const el = document.getElementById(id);
+  const out = document.getElementById(id + "-out");
+  const set = () => { if (out) out.textContent = el.value; };
+  if (el.type === "checkbox") el.checked = !!state[id]; else el.value = state[id];
+  set();
+  el.addEventListener("input", () => {
+    state[id] = el.type === "checkbox" ? el.checked : parse(el.value);
+    set();
+    update();
+  });
+}
+
+// ------------------------------------------------------------------ drawing helpers
+function axes(ctx, w, h, xr, yr, log, xlabel, ylabel) {
+  const m = { l: 48, r: 10, t: 10, b: 32 };
+  ctx.clearRect(0, 0, w, h);
+  ctx.fillStyle = "#fff"; ctx.fillRect(0, 0, w, h);
+  ctx.strokeStyle = "#999"; ctx.lineWidth = 1;
+  ctx.strokeRect(m.l, m.t, w - m.l - m.r, h - m.t - m.b);
+  const X = x => m.l + (x - xr[0]) / (xr[1] - xr[0]) * (w - m.l - m.r);
+  const ty = y => log ? Math.log10(Math.max(y, 1e-12)) : y;
+  const y0 = ty(yr[0]), y1 = ty(yr[1]);
+  const Y = y => h - m.b - (ty(y) - y0) / ((y1 - y0) || 1) * (h - m.t - m.b);
+  ctx.fillStyle = "#333"; ctx.font = "11px sans-serif";
+  ctx.fillText(xlabel, w / 2 - 40, h - 6);
+  ctx.save(); ctx.translate(12, h / 2 + 30); ctx.rotate(-Math.PI / 2); ctx.fillText(ylabel, 0, 0); ctx.restore();
+  for (let k = 0; k <= 4; k++) {
+    const x = xr[0] + k * (xr[1] - xr[0]) / 4;
+    ctx.fillText(x.toFixed(0), X(x) - 8, h - m.b + 12);
+    const yv = log ? Math.pow(10, y0 + k * (y1 - y0) / 4) : yr[0] + k * (yr[1] - yr[0]) / 4;
+    ctx.fillText(yv.toPrecision(2), 2, Y(yv) + 4);
+  }
+  return { X, Y };
+}
+
+function range(curves, log) {
+  let lo = Infinity, hi = -Infinity;
+  for (const c of curves) for (const v of c) {
+    if (log && !(v > 0)) continue;
+    lo = Math.min(lo, v); hi = Math.max(hi, v);
+  }
+  if (!isFinite(lo)) { lo = log ? 1e-3 : 0; hi = 1; }
+  if (log) lo = Math.max(lo, hi * 1e-5); else lo = Math.min(0, lo);
+  if (hi <= lo) hi = lo + 1;
+  return [lo, hi * (log ? 1.5 : 1.05)];
+}
+
+function polyline(ctx, xs, ys, T, colour, dash) {
+  ctx.strokeStyle = colour; ctx.lineWidth = 1.6; ctx.setLineDash(dash || []);
+  ctx.beginPath();
+  let started = false;
+  xs.forEach((x, k) => {
+    const y = ys[k];
+    if (!isFinite(y) || (state.log && !(y > 0))) { started = false; return; }
+    if (!started) { ctx.moveTo(T.X(x), T.Y(y)); started = true; } else ctx.lineTo(T.X(x), T.Y(y));
+  });
+  ctx.stroke(); ctx.setLineDash([]);
+}
+
+function drawPolar(items) {
+  const cv = document.getElementById("polar"), ctx = cv.getContext("2d");
+  const w = cv.width, h = cv.height;
+  ctx.fillStyle = "#fff"; ctx.fillRect(0, 0, w, h);
+  const cx = w / 2, cy = h - 24, R = Math.min(w / 2 - 10, h - 40);
+  const all = items.flatMap(([v]) => v.polar.values);
+  const [lo, hi] = range(all, state.log);
+  const rad = y => state.log ? Math.max(0, (Math.log10(Math.max(y, lo)) - Math.log10(lo)) / (Math.log10(hi) - Math.log10(lo))) : y / hi;
+  ctx.strokeStyle = "#ccc"; ctx.lineWidth = 1;
+  for (const f of [0.25, 0.5, 0.75, 1]) { ctx.beginPath(); ctx.arc(cx, cy, R * f, Math.PI, 2 * Math.PI); ctx.stroke(); }
+  ctx.beginPath(); ctx.moveTo(cx - R, cy); ctx.lineTo(cx + R, cy); ctx.stroke();
+  // the incident direction (on the left: negative θ_o side)
+  const ti = state.theta_i * Math.PI / 180;
+  ctx.strokeStyle = "#e69500"; ctx.beginPath(); ctx.moveTo(cx, cy);
+  ctx.lineTo(cx - R * Math.sin(ti), cy - R * Math.cos(ti)); ctx.stroke();
+  ctx.fillStyle = "#333"; ctx.font = "11px sans-serif";
+  ctx.fillText("max " + hi.toPrecision(3) + (state.log ? " (log radius)" : " (radius ∝ f)"), 6, 14);
+  for (const [v, i] of items) {
+    v.polar.values.forEach((ys, c) => {
+      ctx.strokeStyle = COLOURS[i % COLOURS.length]; ctx.lineWidth = 1.6;
+      ctx.setLineDash(CHANNEL_DASH[c % 3]); ctx.beginPath();
+      v.polar.theta_o_deg.forEach((t, k) => {
+        const r = R * Math.min(1, rad(ys[k])), a = t * Math.PI / 180;
+        const x = cx + r * Math.sin(a), y = cy - r * Math.cos(a);
+        if (k === 0) ctx.moveTo(x, y); else ctx.lineTo(x, y);
+      });
+      ctx.stroke(); ctx.setLineDash([]);
+    });
+  }
+}
+
+function drawLobe(items) {
+  const cv = document.getElementById("lobe"), ctx = cv.getContext("2d");
+  const w = cv.width, h = cv.height;
+  ctx.fillStyle = "#fff"; ctx.fillRect(0, 0, w, h);
+  const cy = Math.cos(lobeView.yaw), sy = Math.sin(lobeView.yaw);
+  const cp = Math.cos(lobeView.pitch), sp = Math.sin(lobeView.pitch);
+  const S = Math.min(w, h) * 0.42;
+  const P = (x, y, z) => {  // rotate about z (yaw) then tilt (pitch); z up on screen
+    const x1 = cy * x - sy * y, y1 = sy * x + cy * y;
+    const y2 = cp * y1 - sp * z, z2 = sp * y1 + cp * z;
+    return [w / 2 + S * x1, h * 0.78 - S * z2, y2];
+  };
+  ctx.strokeStyle = "#bbb"; ctx.beginPath();
+  for (let k = 0; k <= 48; k++) {
+    const a = 2 * Math.PI * k / 48, p = P(Math.cos(a), Math.sin(a), 0);
+    if (k === 0) ctx.moveTo(p[0], p[1]); else ctx.lineTo(p[0], p[1]);
+  }
+  ctx.stroke();
+  for (const [v, i] of items) {
+    const L = v.lobe;
+    ctx.strokeStyle = COLOURS[i % COLOURS.length]; ctx.lineWidth = 0.8;
+    const nt = L.x.length, np = L.x[0].length;
+    for (let a = 0; a < nt; a++) {
+      ctx.beginPath();
+      for (let b = 0; b < np; b++) {
+        const p = P(L.x[a][b], L.y[a][b], L.z[a][b]);
+        if (b === 0) ctx.moveTo(p[0], p[1]); else ctx.lineTo(p[0], p[1]);
+      }
+      ctx.stroke();
+    }
+    for (let b = 0; b < np; b += 2) {
+      ctx.beginPath();
+      for (let a = 0; a < nt; a++) {
+        const p = P(L.x[a][b], L.y[a][b], L.z[a][b]);
+        if (a === 0) ctx.moveTo(p[0], p[1]); else ctx.lineTo(p[0], p[1]);
+      }
+      ctx.stroke();
+    }
+    const wi = L.wi, o = P(0, 0, 0), q = P(wi[0], wi[1], wi[2]);
+    ctx.strokeStyle = "#e69500"; ctx.lineWidth = 2; ctx.beginPath();
+    ctx.moveTo(o[0], o[1]); ctx.lineTo(q[0], q[1]); ctx.stroke();
+  }
+}
+
+function drawCurves(items) {
+  const cv = document.getElementById("curves"), ctx = cv.getContext("2d");
+  const all = items.flatMap(([v]) => [...v.curves.theta_h, ...v.curves.theta_d, ...v.curves.theta_o.values]);
+  const T = axes(ctx, cv.width, cv.height, [-90, 90], range(all, state.log), state.log,
+                 "angle (deg): θh solid, θd dashed (right half); θo dotted (full)", "f (1/sr)");
+  for (const [v, i] of items) {
+    const col = COLOURS[i % COLOURS.length], x = v.curves.angle_deg;
+    v.curves.theta_h.forEach(ys => polyline(ctx, x, ys, T, col, []));
+    v.curves.theta_d.forEach(ys => polyline(ctx, x, ys, T, col, [6, 3]));
+    v.curves.theta_o.values.forEach(ys => polyline(ctx, v.curves.theta_o.theta_o_deg, ys, T, col, [2, 3]));
+  }
+}
+
+function drawAlbedo(items) {
+  const cv = document.getElementById("albedo"), ctx = cv.getContext("2d");
+  const all = items.flatMap(([v]) => v.albedo.values);
+  const hi = Math.max(1.05, ...all.flat().filter(isFinite));
+  const T = axes(ctx, cv.width, cv.height, [0, 90], [0, hi], false, "θi (deg)", "albedo a(θi)");
+  ctx.strokeStyle = "#aaa"; ctx.setLineDash([4, 4]); ctx.beginPath();
+  ctx.moveTo(T.X(0), T.Y(1)); ctx.lineTo(T.X(90), T.Y(1)); ctx.stroke(); ctx.setLineDash([]);
+  for (const [v, i] of items) {
+    v.albedo.values.forEach((ys, c) => polyline(ctx, v.albedo.theta_deg, ys, T,
+                                                COLOURS[i % COLOURS.length], CHANNEL_DASH[c % 3]));
+  }
+}
+
+function drawImages(id, items, key) {
+  const box = document.getElementById(id);
+  box.innerHTML = "";
+  for (const [v, i] of items) {
+    const f = document.createElement("figure");
+    const img = document.createElement("img");
+    img.src = v[key]; img.alt = key + " of " + v.name;
+    img.style.borderColor = COLOURS[i % COLOURS.length];
+    img.dataset.model = i;
+    if (key === "sphere") attachLightDrag(img);
+    const cap = document.createElement("figcaption");
+    cap.textContent = v.name;
+    f.appendChild(img); f.appendChild(cap); box.appendChild(f);
+  }
+}
+
+function attachLightDrag(img) {
+  const move = ev => {
+    if (!(ev.buttons & 1)) return;
+    const r = img.getBoundingClientRect();
+    // the pointer marks where on the sphere the light is overhead: N = (x, y, z) → Φ_L = acos z
+    const x = ((ev.clientX - r.left) / r.width) * 2 - 1, y = 1 - ((ev.clientY - r.top) / r.height) * 2;
+    const z = Math.sqrt(Math.max(0, 1 - x * x - y * y));
+    state.phi_l = Math.round(Math.min(175, Math.acos(z) * 180 / Math.PI));
+    document.getElementById("phi_l").value = state.phi_l;
+    document.getElementById("phi_l-out").textContent = state.phi_l;
+    update();
+  };
+  img.addEventListener("mousemove", move);
+  img.addEventListener("mousedown", move);
+  img.draggable = false;
+}
+
+function drawAll() {
+  if (!lastViews) return;
+  const ok = [];
+  lastViews.models.forEach((v, k) => {
+    const i = lastViews.index[k];
+    const err = document.getElementById("model-error-" + i);
+    if (v.error) { if (err) err.textContent = v.error; return; }
+    if (err) err.textContent = "";
+    ok.push([v, i]);
+  });
+  drawPolar(ok); drawLobe(ok); drawCurves(ok); drawAlbedo(ok);
+  drawImages("spheres", ok, "sphere"); drawImages("halfdiffs", ok, "halfdiff");
+  const errors = lastViews.models.filter(v => v.error).map(v => v.spec + ": " + v.error);
+  showMessage(errors.join(" · "));
+}
+
+// ------------------------------------------------------------------ updates
+function request() {
+  const vis = visibleEntries();
+  return { body: Object.assign({}, state, { models: vis.map(([m]) => m) }), index: vis.map(([, i]) => i) };
+}
+
+async function update() {
+  writeHash();
+  pending = request();
+  if (inflight) return;  // the newest state is sent when the running request returns
+  while (pending) {
+    const req = pending; pending = null; inflight = true;
+    document.getElementById("status").textContent = "updating…";
+    try {
+      const t0 = performance.now();
+      const data = await api("/api/views", req.body);
+      lastViews = { models: data.models, index: req.index };
+      drawAll();
+      document.getElementById("timing").textContent =
+        "views " + data.ms + " ms on the server, " + Math.round(performance.now() - t0) + " ms round trip";
+      document.getElementById("status").textContent = "ready";
+      fetchVerdicts(req);
+    } catch (e) {
+      showMessage(e.message);
+      document.getElementById("status").textContent = "error";
+    } finally {
+      inflight = false;
+    }
+  }
+}
+
+let verdictSeq = 0;
+async function fetchVerdicts(req) {
+  const seq = ++verdictSeq;
+  const box = document.getElementById("verdicts");
+  box.textContent = "verdict: computing…";
+  try {
+    const data = await api("/api/verdict", req.body);
+    if (seq !== verdictSeq) return;
+    box.innerHTML = "";
+    data.verdicts.forEach((v, k) => {
+      const line = document.createElement("div");
+      const i = req.index[k];
+      line.style.color = COLOURS[i % COLOURS.length];
+      if (v.error) { line.textContent = v.spec + ": " + v.error; box.appendChild(line); return; }
+      let energy = v.energy;
+      if (v.energy === "diverges") energy += " at grazing, a ~ cos^-" + v.divergence_exponent;
+      if (v.energy === "exceeds") energy += " 1 (×" + Number(v.max_scale).toPrecision(3) + " fixes it)";
+      line.innerHTML = "<b>" + v.model + "</b>: reciprocal " + (v.reciprocal ? "yes" : "no") +
+        "; energy <span class='" + (v.energy === "conserves" ? "verdict-ok" : "verdict-bad") + "'>" +
+        energy + "</span>; max albedo " + Number(v.max_albedo).toPrecision(4) + " at " + v.theta_max_deg + "°";
+      line.className = "verdict";
+      box.appendChild(line);
+    });
+  } catch (e) {
+    if (seq === verdictSeq) box.textContent = "verdict: " + e.message;
+  }
+}
+
+function download(name, blob) {
+  const a = document.createElement("a");
+  a.href = URL.createObjectURL(blob); a.download = name; a.click();
+  setTimeout(() => URL.revokeObjectURL(a.href), 1000);
+}
+
+async function init() {
+  state = readHash();
+  try {
+    catalog = await api("/api/catalog");
+  } catch (e) {
+    showMessage("cannot load the model catalog: " + e.message);
+    return;
+  }
+  const dl = document.getElementById("spec-list");
+  for (const m of catalog.models) { const o = document.createElement("option"); o.value = m.name; dl.appendChild(o); }
+  for (const s of catalog.materials) { const o = document.createElement("option"); o.value = s; dl.appendChild(o); }
+  renderModelList();
+  bindGlobal("theta_i", Number); bindGlobal("phi_i", Number); bindGlobal("phi_l", Number);
+  bindGlobal("ambient", Number); bindGlobal("mode", String); bindGlobal("log", Boolean);
+  bindGlobal("cosine", Boolean);
+  document.getElementById("log").addEventListener("change", drawAll);
+  document.getElementById("add-form").addEventListener("submit", ev => {
+    ev.preventDefault();
+    const spec = document.getElementById("add-spec").value.trim();
+    if (!spec) return;
+    state.models.push({ spec, params: {}, pump: null, times: 1, visible: true });
+    document.getElementById("add-spec").value = "";
+    renderModelList(); update();
+  });
+  document.getElementById("share").addEventListener("click", () => {
+    writeHash();
+    if (navigator.clipboard) navigator.clipboard.writeText(location.href).catch(() => {});
+    showMessage("link: " + location.href);
+  });
+  document.getElementById("export-json").addEventListener("click", () => {
+    const models = (lastViews ? lastViews.models : []).filter(v => !v.error)
+      .map(v => ({ model: v.name, params: v.params }));
+    download("brdfkit-models.json", new Blob([JSON.stringify(models, null, 2)], { type: "application/json" }));
+  });
+  document.getElementById("export-binary").addEventListener("click", async () => {
+    const vis = visibleEntries();
+    if (!vis.length) { showMessage("no model to export"); return; }
+    const res = await fetch("/api/export/binary", { method: "POST", headers: { "Content-Type": "application/json" },
+                                                   body: JSON.stringify(vis[0][0]) });
+    if (!res.ok) { showMessage((await res.json()).error); return; }
+    download(vis[0][0].spec.replace(/[^A-Za-z0-9._-]/g, "_") + ".binary", await res.blob());
+  });
+  for (const b of document.querySelectorAll("button.png")) {
+    b.addEventListener("click", () => {
+      const cv = document.getElementById(b.dataset.for);
+      cv.toBlob(blob => download("brdfkit-" + b.dataset.for + ".png", blob));
+    });
+  }
+  const lobe = document.getElementById("lobe");
+  let drag = null;
+  lobe.addEventListener("mousedown", ev => { drag = [ev.clientX, ev.clientY, lobeView.yaw, lobeView.pitch]; });
+  window.addEventListener("mouseup", () => { drag = null; });
+  lobe.addEventListener("mousemove", ev => {
+    if (!drag) return;
+    lobeView.yaw = drag[2] + (ev.clientX - drag[0]) * 0.01;
+    lobeView.pitch = Math.max(-0.2, Math.min(1.5, drag[3] + (ev.clientY - drag[1]) * 0.01));
+    if (lastViews) drawLobe(lastViews.models.map((v, k) => [v, lastViews.index[k]]).filter(([v]) => !v.error));
+  });
+  update();
+}
+
+window.addEventListener("DOMContentLoaded", init);
