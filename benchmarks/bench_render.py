@@ -73,8 +73,8 @@ def main(argv=None):
         k = _lit_pixels(S, *L, wi, wo, idx, cos_l)
         a, b = wi[:k], wo[:k]
         for name, m in models.items():
-            t_r = _median_time(lambda m=m: render_sphere(m, phi_l=phi, size=S), args.repeats)
-            t_e = _median_time(lambda m=m: m.eval(a, b), args.repeats)
+            t_r = _median_time(lambda m=m, S=S: render_sphere(m, phi_l=phi, size=S), args.repeats)
+            t_e = _median_time(lambda m=m, a=a, b=b: m.eval(a, b), args.repeats)
             ok = "" if S != 512 else ("met" if t_r <= TARGET_512_S else "MISSED")
             print(f"{name:24s} {S:5d} {1e3 * t_r:10.2f} {S * S / t_r / 1e6:8.1f} "
                   f"{1e3 * t_e:8.2f} {t_r / t_e:11.2f} {ok:>7s}")

@@ -20,8 +20,8 @@ and 0 outside the disc (a black background). f_r is evaluated in each pixel's
 local frame (N = +z local): tangent T = the world x axis projected onto the
 tangent plane, T = (x̂ − N_x N)/√(1 − N_x²), and B = N × T. For an isotropic
 model any tangent gives the same value; for an anisotropic one this is the
-stated choice of tangent (the projected x axis). No sampling: the direct term is the model's kernel at
-the pixel centre, the ambient term the tabulated albedo integral with its
+stated choice of tangent (the projected x axis). No sampling: the direct term
+is the model's kernel at the pixel centre, the ambient term the tabulated albedo integral with its
 stated error. The sphere does not shadow itself (it is convex) and there is
 no interreflection.
 
@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+
 import numba
 import numpy as np
 
