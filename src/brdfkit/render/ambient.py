@@ -161,6 +161,9 @@ class AmbientTable:
     success: bool
     message: str
 
+    def __post_init__(self):
+        object.__setattr__(self, "_interp", _spline(self.theta, self.rho))
+
     @property
     def theta_max(self) -> float:
         return float(self.theta[-1])
@@ -168,10 +171,10 @@ class AmbientTable:
     def __call__(self, theta) -> np.ndarray:
         """ρ at *theta* (radians in [0, θ_max]), shape ``theta.shape + (C,)``."""
         th = np.asarray(theta, dtype=np.float64)
-        if np.any(th > self.theta_max * (1 + 1e-12)) or np.any(th < 0):
+        if th.size and not (th.min() >= 0.0 and th.max() <= self.theta_max * (1 + 1e-12)):
             raise ParameterError(f"theta must lie in [0, {self.theta_max!r}] rad (the table's "
                                  "range); build a table reaching further")
-        return _spline(self.theta, self.rho)(th)
+        return self._interp(th)
 
 
 def _spline(theta, rho) -> CubicSpline:

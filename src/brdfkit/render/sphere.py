@@ -308,12 +308,20 @@ def render_sphere(model: BRDF, *, phi_l: float, ambient: float = 0.0, irradiance
     c, mask = _disc(S)
     err, msg, ok = 0.0, "", True
     if L_a > 0.0:
-        x, y = np.meshgrid(c, -c)
-        r2 = (x * x + y * y)[mask]
-        theta_v = np.arccos(np.sqrt(1.0 - r2))  # θ_V = angle between N and V = ẑ
+        # ρ(θ_V) is the same at (±x, ±y): evaluate one quadrant (the first h rows and
+        # columns, h = ⌈S/2⌉) and mirror it; N_z = √(1 − x² − y²) = cos θ_V
+        h = (S + 1) // 2
+        q = c[:h] ** 2
+        r2 = q[:, None] + q[None, :]
+        inside = r2 < 1.0
+        theta_v = np.arccos(np.sqrt(1.0 - r2[inside]))  # θ_V = angle between N and V = ẑ
         # at least 1e-3 rad: the one pixel of a 1×1 image has θ_V = 0; the table needs a range
         table = ambient_table(model, theta_max=max(float(np.max(theta_v)), 1e-3), tol=rho_tol)
-        out[np.flatnonzero(mask)] += L_a * table(theta_v)
+        quadrant = np.zeros((h, h, C))
+        quadrant[inside] = L_a * table(theta_v)
+        # mirror: columns (and then rows) 0 … h−1 followed by S − h of them reversed
+        top = np.concatenate([quadrant, quadrant[:, : S - h][:, ::-1]], axis=1)
+        out += np.concatenate([top, top[: S - h][::-1]], axis=0).reshape(S * S, C)
         err, msg, ok = L_a * table.error, table.message, table.success
     return SphereRender(radiance=out.reshape(S, S, C), mask=mask, model=model.to_dict(),
                         phi_l=phi, ambient=L_a, irradiance=E, engine="direct",
