@@ -238,8 +238,8 @@ def table2_cmd(as_json, as_md, models):
 def figure_cmd(name, out, dpi):
     """Reproduce a paper figure by computation and write it to FILE (PNG or SVG).
 
-    NAME is one of the registered figures (e.g. lewis-fig5, lewis-fig7,
-    lewis-fig8, lewis-fig9, neumann-fig1 ... neumann-fig7); 'brdfkit figure
+    NAME is one of the registered figures (e.g. lewis-fig3 ... lewis-fig10,
+    neumann-fig1 ... neumann-fig7); 'brdfkit figure
     list' prints them. Building takes seconds to a minute; when stderr is a
     terminal a 'building ...' line shows it is working.
     """
