@@ -249,6 +249,7 @@ def test_cli_render_sphere(tmp_path):
         assert np.asarray(im).max() == 255  # phi0 exposure: the Φ_L = 0 peak is just white
     for args, text in [(["--engine", "mitsuba"], "not available yet"),
                        (["--phi-l", "200"], "[0, 180]"),
+                       (["--spp", "16"], "takes no samples"),
                        (["--exposure", "-1"], "--exposure"),
                        (["--out", str(tmp_path / "x.jpg")], ".png or .exr or .npy")]:
         argv = ["render", "sphere", "lambert", "--phi-l", "10", "--out", str(png), *args]

@@ -3,7 +3,7 @@ Render commands: ``brdfkit render sphere``
 ==========================================
 
 - ``brdfkit render sphere MODEL [-p …] [--pump …] --phi-l DEG [--ambient L_a]
-  [--irradiance E] [--size S] [--engine direct] [--exposure K|phi0|peak]
+  [--irradiance E] [--size S] [--engine direct] [--spp N] [--exposure K|phi0|peak]
   --out FILE`` — Lewis's sphere test configuration computed exactly
   (:func:`brdfkit.render.render_sphere`), written as ``.npy``/``.exr`` (linear
   radiance) or ``.png`` (sRGB with the stated exposure). Prints the path, or
@@ -62,6 +62,9 @@ def render_group() -> None:
 @click.option("--engine", type=click.Choice(["direct", "mitsuba"]), default="direct",
               show_default=True,
               help="direct: exact, deterministic. mitsuba (Monte Carlo): not available yet.")
+@click.option("--spp", type=int, default=None, metavar="N",
+              help="Samples per pixel of --engine mitsuba (not available yet); the direct "
+                   "engine takes none.")
 @click.option("--exposure", default="phi0", show_default=True, metavar="K|phi0|peak",
               help="PNG only: display value = sRGB(min(1, K x radiance)). phi0: K = 1/peak "
                    "of the same sphere lit at phi_L = 0 (Lewis's rule: held constant across "
@@ -70,8 +73,8 @@ def render_group() -> None:
               help="Output file: .png (sRGB), .exr (linear, 32-bit float) or .npy (linear, "
                    "float64). Written atomically.")
 @click.option("--json", "as_json", is_flag=True, help="Print the render's metadata as JSON.")
-def sphere_cmd(model, param, pump, times, phi_l, ambient, irradiance, size, engine, exposure,
-               out, as_json):
+def sphere_cmd(model, param, pump, times, phi_l, ambient, irradiance, size, engine, spp,
+               exposure, out, as_json):
     """Render MODEL on Lewis's sphere test configuration (Lewis 1993, Fig. 2).
 
     An S x S orthographic image of the unit sphere seen from +z, one
@@ -82,6 +85,9 @@ def sphere_cmd(model, param, pump, times, phi_l, ambient, irradiance, size, engi
     if engine == "mitsuba":
         raise BrdfkitError("--engine mitsuba (Monte Carlo through Mitsuba 3) is not available "
                            "yet; use --engine direct (exact)")
+    if spp is not None:
+        raise BrdfkitError(f"--spp {spp}: the direct engine is exact and takes no samples; "
+                           "drop --spp (it is for --engine mitsuba, not available yet)")
     if not 0.0 <= phi_l <= 180.0:  # also refuses NaN
         raise BrdfkitError(f"--phi-l must lie in [0, 180] degrees; got {phi_l}")
     for name, v in (("--ambient", ambient), ("--irradiance", irradiance)):
