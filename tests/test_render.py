@@ -29,6 +29,7 @@ from brdfkit.render import (
     save_render,
     sphere_geometry,
     to_srgb8,
+    transposed,
     write_exr,
 )
 
@@ -105,6 +106,25 @@ def test_phong_pixels_by_hand_in_the_world_frame():
         f = k_d + k_s * max(R @ V, 0.0) ** n / nl if nl > 0 else 0 * k_d
         assert inside[row, col]
         assert np.allclose(r.radiance[row, col], E * f * max(nl, 0.0), rtol=1e-12, atol=1e-15)
+
+
+def test_transposed_model_pixels_by_hand():
+    # a derived model (brdfkit.render.transposed: the compiled kernel with its directions
+    # exchanged) rendered like any model: E·f(V, L)·max(N·L, 0) with Lewis's Phong
+    # f(S, V) = k_d + k_s max(R_S·V, 0)^n/(N·S), so f(V, L) = k_d + k_s max(R_V·L, 0)^n/(N·V)
+    k_d, k_s, n = 0.05, 0.9, 12.0
+    m = transposed(brdfkit.model("phong", k_d=k_d, k_s=k_s, n=n))
+    assert m.name == "phong^T" and not m.reciprocal
+    S, phi = 10, math.radians(70.0)
+    r = render_sphere(m, phi_l=phi, size=S)
+    N, _ = _normals(S)
+    L = np.array([math.sin(phi), 0.0, math.cos(phi)])
+    V = np.array([0.0, 0.0, 1.0])
+    for row, col in [(4, 6), (2, 7), (7, 8), (5, 5)]:
+        nv = N[row, col]
+        R_V = 2 * (nv @ V) * nv - V
+        f = k_d + k_s * max(R_V @ L, 0.0) ** n / (nv @ V)
+        assert r.radiance[row, col, 0] == pytest.approx(f * max(nv @ L, 0.0), rel=1e-12)
 
 
 def test_ambient_of_a_non_reciprocal_model_integrates_over_the_light():
