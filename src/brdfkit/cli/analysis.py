@@ -255,10 +255,10 @@ def table2_cmd(as_json, as_md, models):
 def figure_cmd(name, out, dpi, model, param, pump, times, compare):
     """Reproduce a paper figure by computation and write it to FILE (PNG or SVG).
 
-    NAME is one of the registered figures (e.g. lewis-fig5, lewis-fig7,
-    lewis-fig8, lewis-fig9, neumann-fig1 ... neumann-fig7); 'brdfkit figure
-    list' prints them. 'slices' draws in-plane slices and the albedo of
-    --model (and --compare models), e.g.
+    NAME is one of the registered figures (e.g. lewis-fig3 ... lewis-fig10,
+    neumann-fig1 ... neumann-fig7); 'brdfkit figure list' prints them.
+    'slices' draws in-plane slices and the albedo of --model (and --compare
+    models), e.g.
     brdfkit figure slices --model merl:nickel --compare merl:nickel@abc --out n.png
 
     Building takes seconds to a minute; when stderr is a

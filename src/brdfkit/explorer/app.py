@@ -15,8 +15,8 @@ canvases: no CDN, the page works offline) and a JSON API:
 
 A state is ``{"models": [{"spec", "params", "pump", "times", "visible"}],
 "theta_i", "phi_i", "phi_l" (Φ_L of the sphere test, 0–180), "ambient" (angles
-in degrees, as on the command line), "mode": "luminance"|"rgb", "cosine": bool}``. A model that cannot be
-built (unknown spec, parameter out of bounds, unreadable file) comes back as
+in degrees, as on the command line), "mode": "luminance"|"rgb", "cosine": bool}``.
+A model that cannot be built (unknown spec, parameter out of bounds, unreadable file) comes back as
 ``{"spec", "error"}`` and the page shows the message; the other models are
 drawn. Models are cached by their full description (a pumped model's tables
 are built once).

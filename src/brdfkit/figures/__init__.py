@@ -12,7 +12,9 @@ Layout (imports go downward only)
 - :mod:`~brdfkit.figures._save` — output-path checks and the atomic writer;
   knows no figure.
 - :mod:`~brdfkit.figures.lewis` (``lewis-fig5``, ``lewis-fig7``,
-  ``lewis-fig8``, ``lewis-fig9``), :mod:`~brdfkit.figures.neumann`
+  ``lewis-fig8``, ``lewis-fig9``), :mod:`~brdfkit.figures.lewis_spheres`
+  (``lewis-fig3``, ``lewis-fig4``, ``lewis-fig6``, ``lewis-fig10``: rendered
+  spheres), :mod:`~brdfkit.figures.neumann`
   (``neumann-fig1``), :mod:`~brdfkit.figures.pumping` (``neumann-fig3`` …
   ``neumann-fig7``) — plain figure functions; they import the library, never
   :mod:`brdfkit.figures`.

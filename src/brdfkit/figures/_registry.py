@@ -1,6 +1,7 @@
 """The figure registry: every figure name listed once, explicitly.
 
 Each figure module (:mod:`~brdfkit.figures.lewis`,
+:mod:`~brdfkit.figures.lewis_spheres`,
 :mod:`~brdfkit.figures.neumann`, :mod:`~brdfkit.figures.pumping`) defines
 plain functions and imports nothing from :mod:`brdfkit.figures`; this module
 imports them (downward) and names them. To add a figure, write the function
@@ -13,7 +14,7 @@ from collections.abc import Callable, Mapping
 from types import MappingProxyType
 
 from brdfkit.errors import BrdfkitError
-from brdfkit.figures import lewis, neumann
+from brdfkit.figures import lewis, lewis_spheres, neumann
 from brdfkit.figures import models as model_figures
 from brdfkit.figures import pumping as pumping_figures
 from brdfkit.figures._save import check_output_path, save_atomic
@@ -23,10 +24,14 @@ __all__ = ["FIGURES", "MODEL_FIGURES", "figure_names", "resolve_figure", "make_f
 
 #: name → function returning a Matplotlib Figure (read-only: edit the list here).
 FIGURES: Mapping[str, Callable] = MappingProxyType({
+    "lewis-fig3": lewis_spheres.lewis_fig3,
+    "lewis-fig4": lewis_spheres.lewis_fig4,
     "lewis-fig5": lewis.lewis_fig5,
+    "lewis-fig6": lewis_spheres.lewis_fig6,
     "lewis-fig7": lewis.lewis_fig7,
     "lewis-fig8": lewis.lewis_fig8,
     "lewis-fig9": lewis.lewis_fig9,
+    "lewis-fig10": lewis_spheres.lewis_fig10,
     "neumann-fig1": neumann.neumann_fig1,
     "neumann-fig3": pumping_figures.neumann_fig3,
     "neumann-fig4": pumping_figures.neumann_fig4,

@@ -1,0 +1,120 @@
+"""
+Render commands: ``brdfkit render sphere``
+==========================================
+
+- ``brdfkit render sphere MODEL [-p …] [--pump …] --phi-l DEG [--ambient L_a]
+  [--irradiance E] [--size S] [--engine direct] [--spp N] [--exposure K|phi0|peak]
+  --out FILE`` — Lewis's sphere test configuration computed exactly
+  (:func:`brdfkit.render.render_sphere`), written as ``.npy``/``.exr`` (linear
+  radiance) or ``.png`` (sRGB with the stated exposure). Prints the path, or
+  the render's metadata with ``--json``.
+
+Angles are in degrees on the command line. ``--engine mitsuba`` (Monte Carlo)
+is not available yet and says so.
+"""
+
+from __future__ import annotations
+
+import math
+
+import click
+
+from brdfkit import _io
+from brdfkit.cli._common import build_model, emit_json, model_options
+from brdfkit.errors import BrdfkitError
+from brdfkit.render import MAX_SIZE, SUFFIXES, exposure_phi0, render_sphere, save_render
+
+__all__ = ["render_group", "sphere_cmd", "parse_exposure"]
+
+
+def parse_exposure(text: str) -> float | str:
+    """``phi0`` | ``peak`` | a number > 0 → the exposure rule or factor."""
+    s = str(text).strip().lower()
+    if s in ("phi0", "peak"):
+        return s
+    try:
+        k = float(s)
+    except ValueError:
+        k = math.nan
+    if not (k > 0.0 and math.isfinite(k)):
+        raise BrdfkitError(f"--exposure must be 'phi0', 'peak' or a number > 0 (display value "
+                           f"= min(1, K x radiance) before sRGB encoding); got {text!r}")
+    return k
+
+
+@click.group("render")
+def render_group() -> None:
+    """Render images of a model (exact sphere test configuration)."""
+
+
+@click.command("sphere")
+@model_options
+@click.option("--phi-l", "phi_l", type=float, required=True, metavar="DEG",
+              help="Angle between the light and the view direction, DEGREES in [0, 180]; the "
+                   "light shines from L = (sin phi_L, 0, cos phi_L), the viewer is at +z.")
+@click.option("--ambient", type=float, default=0.0, show_default=True, metavar="L_A",
+              help="Uniform ambient radiance L_a >= 0 over every normal's hemisphere; it adds "
+                   "L_a x rho(V), rho computed by the albedo engine.")
+@click.option("--irradiance", type=float, default=1.0, show_default=True, metavar="E",
+              help="Irradiance E >= 0 of the directional light on a surface facing it.")
+@click.option("--size", type=int, default=256, show_default=True, metavar="S",
+              help=f"Image side in pixels, 1 to {MAX_SIZE}.")
+@click.option("--engine", type=click.Choice(["direct", "mitsuba"]), default="direct",
+              show_default=True,
+              help="direct: exact, deterministic. mitsuba (Monte Carlo): not available yet.")
+@click.option("--spp", type=int, default=None, metavar="N",
+              help="Samples per pixel of --engine mitsuba (not available yet); the direct "
+                   "engine takes none.")
+@click.option("--exposure", default="phi0", show_default=True, metavar="K|phi0|peak",
+              help="PNG only: display value = sRGB(min(1, K x radiance)). phi0: K = 1/peak "
+                   "of the same sphere lit at phi_L = 0 (Lewis's rule: held constant across "
+                   "a series); peak: K = 1/peak of this image.")
+@click.option("--out", required=True, metavar="FILE",
+              help="Output file: .png (sRGB), .exr (linear, 32-bit float) or .npy (linear, "
+                   "float64). Written atomically.")
+@click.option("--json", "as_json", is_flag=True, help="Print the render's metadata as JSON.")
+def sphere_cmd(model, param, pump, times, phi_l, ambient, irradiance, size, engine, spp,
+               exposure, out, as_json):
+    """Render MODEL on Lewis's sphere test configuration (Lewis 1993, Fig. 2).
+
+    An S x S orthographic image of the unit sphere seen from +z, one
+    directional light at phi_L from the viewer and an optional uniform
+    ambient radiance; radiance E f_r(L, V) max(N.L, 0) + L_a rho(V) at each
+    pixel centre, 0 outside the disc (docs/rendering.md).
+    """
+    if engine == "mitsuba":
+        raise BrdfkitError("--engine mitsuba (Monte Carlo through Mitsuba 3) is not available "
+                           "yet; use --engine direct (exact)")
+    if spp is not None:
+        raise BrdfkitError(f"--spp {spp}: the direct engine is exact and takes no samples; "
+                           "drop --spp (it is for --engine mitsuba, not available yet)")
+    if not 0.0 <= phi_l <= 180.0:  # also refuses NaN
+        raise BrdfkitError(f"--phi-l must lie in [0, 180] degrees; got {phi_l}")
+    for name, v in (("--ambient", ambient), ("--irradiance", irradiance)):
+        if not (v >= 0.0 and math.isfinite(v)):
+            raise BrdfkitError(f"{name} must be a finite number >= 0; got {v}")
+    if not 1 <= size <= MAX_SIZE:
+        raise BrdfkitError(f"--size must be an integer from 1 to {MAX_SIZE} pixels; got {size}")
+    rule = parse_exposure(exposure)
+    _io.check_output_path(out, option="--out", suffixes=SUFFIXES)  # before any work
+    m = build_model(model, param, pump, times)
+    result = render_sphere(m, phi_l=math.radians(phi_l), ambient=ambient,
+                           irradiance=irradiance, size=size)
+    k, how = None, ""
+    if out.lower().endswith(".png"):
+        if rule == "phi0":
+            k = exposure_phi0(m, ambient=ambient, irradiance=irradiance, size=size)
+            how = "1/peak of the same sphere at phi_L = 0 (Lewis 1993 Sec. 3.3)"
+        elif rule == "peak":
+            if not result.peak > 0.0:
+                raise BrdfkitError("--exposure peak: the image is black (peak radiance 0); "
+                                   "give --exposure K")
+            k, how = 1.0 / result.peak, "1/peak of this image"
+        else:
+            k, how = rule, "given (--exposure)"
+    save_render(result, out, exposure=k, exposure_rule=how, option="--out")
+    if as_json:
+        emit_json(dict(result.metadata(), out=out, exposure=k, exposure_rule=how))
+    else:
+        click.echo(out)
+

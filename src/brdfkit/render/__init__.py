@@ -1,0 +1,46 @@
+"""
+Rendering: Lewis's sphere test configuration, computed exactly
+==============================================================
+
+Layer 3 (docs/architecture.md): reads only the model protocol and the albedo
+engine; the command line (``brdfkit render sphere``) and the figures
+(``lewis-fig3``, ``lewis-fig4``, ``lewis-fig6``, ``lewis-fig10``) call it.
+Geometry, units, the exposure rule and the accuracy of the ambient term are
+stated in ``docs/rendering.md``.
+
+Modules
+-------
+- :mod:`brdfkit.render.sphere` — :func:`render_sphere`, :class:`SphereRender`,
+  :func:`sphere_geometry`, :func:`exposure_phi0`.
+- :mod:`brdfkit.render.ambient` — ρ(V) = ∫ f_r(L′, V) cos θ_L′ dω_L′ tabulated
+  (:func:`ambient_table`), :func:`transposed`.
+- :mod:`brdfkit.render.image` — ``.npy``, ``.exr`` (own writer), ``.png``
+  (sRGB with a stated exposure), atomic.
+
+References
+----------
+- [Lewis1993] Fig. 2, eq. (7), Figs. 3, 4, 6, 10.
+"""
+
+from brdfkit.render.ambient import AmbientTable, ambient_table, transposed
+from brdfkit.render.image import (
+    SUFFIXES,
+    save_render,
+    srgb_encode,
+    to_srgb8,
+    write_exr,
+    write_npy,
+    write_png,
+)
+from brdfkit.render.sphere import (
+    ENGINES,
+    MAX_SIZE,
+    SphereRender,
+    exposure_phi0,
+    render_sphere,
+    sphere_geometry,
+)
+
+__all__ = ["AmbientTable", "ENGINES", "MAX_SIZE", "SUFFIXES", "SphereRender", "ambient_table",
+           "exposure_phi0", "render_sphere", "save_render", "sphere_geometry", "srgb_encode",
+           "to_srgb8", "transposed", "write_exr", "write_npy", "write_png"]

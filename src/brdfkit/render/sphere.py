@@ -1,0 +1,351 @@
+"""
+Lewis's sphere test configuration, computed exactly
+===================================================
+
+An S×S image of the unit sphere seen orthographically from +z (Lewis 1993,
+Fig. 2): V = +z at every pixel; pixel (row r, column c) has its centre at
+
+    x = (c + ½)/S·2 − 1,    y = 1 − (r + ½)/S·2,
+
+and, inside the disc x² + y² < 1, the normal N = (x, y, √(1 − x² − y²)).
+One directional light shines toward the sphere from L = (sin Φ_L, 0, cos Φ_L)
+(Φ_L the angle between the light and the viewer, Lewis's Fig. 2) with
+irradiance E on a surface facing it, and a uniform ambient radiance L_a fills
+the hemisphere of every N. The radiance toward the viewer is (Lewis eq. 7)
+
+    L_r = E·f_r(L, V)·max(N·L, 0) + L_a·ρ(V),
+    ρ(V) = ∫ f_r(L′, V) cos θ_L′ dω_L′           (:mod:`brdfkit.render.ambient`),
+
+and 0 outside the disc (a black background). f_r is evaluated in each pixel's
+local frame (N = +z local): tangent T = the world x axis projected onto the
+tangent plane, T = (x̂ − N_x N)/√(1 − N_x²), and B = N × T. For an isotropic
+model any tangent gives the same value; for an anisotropic one this is the
+stated choice of tangent (the projected x axis). No sampling: the direct term
+is the model's kernel at the pixel centre, the ambient term the tabulated albedo integral with its
+stated error. The sphere does not shadow itself (it is convex) and there is
+no interreflection.
+
+A delta (perfectly specular) term (``has_delta``) reflects the directional
+light into exactly one direction, which no pixel centre receives: it adds
+nothing to the direct term, and its specular albedo to ρ(V).
+
+Public objects
+--------------
+- :func:`render_sphere` → :class:`SphereRender`.
+- :func:`sphere_geometry` — pixel centres, disc mask, normals.
+
+References
+----------
+- [Lewis1993] Fig. 2 (test configuration), eq. (7), Figs. 3, 4, 6, 10.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numba
+import numpy as np
+
+from brdfkit.errors import BrdfkitError, ParameterError
+from brdfkit.models import BRDF
+from brdfkit.render.ambient import RHO_TOL, ambient_table
+
+__all__ = ["SphereRender", "render_sphere", "sphere_geometry", "exposure_phi0", "MAX_SIZE",
+           "ENGINES"]
+
+#: Largest image side: 8192² pixels of 3 channels are 1.6 GB of float64 radiance.
+MAX_SIZE = 8192
+#: Engines of :func:`render_sphere`; ``mitsuba`` (Monte Carlo) is planned (issue 11 §3).
+ENGINES = ("direct",)
+
+
+@dataclass(frozen=True)
+class SphereRender:
+    """A render of the sphere test configuration and what it was made from.
+
+    Attributes
+    ----------
+    radiance : ndarray (S, S, C)
+        Linear radiance, in the units of E and L_a per steradian-free unit of
+        f_r (E in W/m² and L_a in W/(m²·sr) give W/(m²·sr)); C = the model's
+        channel count (1 for a scalar model). 0 outside the disc.
+    mask : ndarray of bool (S, S)
+        The disc: pixels whose centre lies on the sphere.
+    model : dict
+        ``model.to_dict()``.
+    phi_l : float
+        Φ_L, radians.
+    ambient, irradiance : float
+        L_a and E.
+    engine : str
+        ``"direct"`` (deterministic; no samples, no variance).
+    ambient_error : float
+        Absolute error estimate of the ambient term L_a·ρ(V) at any pixel
+        (0 when L_a = 0); the direct term is exact to rounding.
+    ambient_message : str
+        The ρ table's accuracy statement (empty when L_a = 0).
+    success : bool
+        Whether the ρ table met its goal.
+    """
+
+    radiance: np.ndarray
+    mask: np.ndarray
+    model: dict
+    phi_l: float
+    ambient: float
+    irradiance: float
+    engine: str = "direct"
+    ambient_error: float = 0.0
+    ambient_message: str = ""
+    success: bool = True
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def size(self) -> int:
+        return int(self.radiance.shape[0])
+
+    @property
+    def peak(self) -> float:
+        """Largest radiance over pixels and channels."""
+        return float(np.max(self.radiance)) if self.radiance.size else 0.0
+
+    def metadata(self) -> dict:
+        """JSON-ready description (angles in degrees)."""
+        return {"model": self.model, "phi_l_deg": math.degrees(self.phi_l),
+                "ambient": self.ambient, "irradiance": self.irradiance, "size": self.size,
+                "channels": int(self.radiance.shape[2]), "engine": self.engine,
+                "ambient_error": self.ambient_error, "ambient_message": self.ambient_message,
+                "success": self.success, "peak": self.peak}
+
+
+@numba.njit(cache=True, inline="always")
+def _pixel(size, r, c, lx, ly, lz):
+    """(x, y, z = N_z, N·L) of pixel (r, c); z < 0 outside the disc."""
+    y = 1.0 - (r + 0.5) / size * 2.0
+    x = (c + 0.5) / size * 2.0 - 1.0
+    r2 = x * x + y * y
+    if r2 >= 1.0:
+        return x, y, -1.0, 0.0  # outside the disc (strictly inside: N_z > 0)
+    z = math.sqrt(1.0 - r2)
+    return x, y, z, lx * x + ly * y + lz * z
+
+
+# Serial, on purpose: measured on the shared 2-core machine (benchmarks/bench_render.py),
+# a prange version of these loops was 2-6x slower than this one whenever the other core was
+# busy (the row loop waits for the descheduled thread); serial it is ~4 ms for 512².
+@numba.njit(cache=True)
+def _lit_pixels(size, lx, ly, lz, wi, wo, index, cos_l):  # pragma: no cover - compiled
+    """The disc pixels with N·L > 0, in row order: local wi, wo, flat index, N·L; returns
+    their count.
+
+    Frame of pixel (x, y, z = N_z): T = (x̂ − x N)/s with s = √(1 − x²) > 0 inside the
+    disc, B = N × T = (0, z/s, −y/s) (worked out from T and N), so in local coordinates
+    wi = (L·T, L·B, L·N) and wo = V = ẑ = (T_z, B_z, N_z) = (−x z/s, −y/s, z).
+    """
+    k = 0
+    for r in range(size):
+        for c in range(size):
+            x, y, z, n_dot_l = _pixel(size, r, c, lx, ly, lz)
+            if not (z > 0.0 and n_dot_l > 0.0):
+                continue  # outside the disc, or max(N·L, 0) = 0: not evaluated
+            s = math.sqrt(1.0 - x * x)
+            wi[k, 0] = (lx * (1.0 - x * x) - ly * x * y - lz * x * z) / s
+            wi[k, 1] = (ly * z - lz * y) / s
+            wi[k, 2] = n_dot_l
+            wo[k, 0] = -x * z / s
+            wo[k, 1] = -y / s
+            wo[k, 2] = z
+            index[k] = r * size + c
+            cos_l[k] = n_dot_l
+            k += 1
+    return k
+
+
+# Not cached on disk: a specialisation is keyed on the kernel's dispatcher, new in every
+# process (as brdfkit.models.eval_pairs). Serial for the reason above; it also writes the
+# image directly, with no arrays of directions in between.
+@numba.njit
+def _direct(kernel, size, lx, ly, lz, P, E, out):  # pragma: no cover - compiled
+    """out[r·S + c, ch] = E·kernel(wi, wo, P[ch])·(N·L) at the lit disc pixels (frames as
+    in :func:`_lit_pixels`); other rows of *out* are left as they are (zeros)."""
+    for r in range(size):
+        for c in range(size):
+            x, y, z, n_dot_l = _pixel(size, r, c, lx, ly, lz)
+            if not (z > 0.0 and n_dot_l > 0.0):
+                continue  # outside the disc, or max(N·L, 0) = 0: nothing to add
+            s = math.sqrt(1.0 - x * x)
+            ix = (lx * (1.0 - x * x) - ly * x * y - lz * x * z) / s
+            iy = (ly * z - lz * y) / s
+            ox = -x * z / s
+            oy = -y / s
+            w = E * n_dot_l
+            for ch in range(P.shape[0]):
+                out[r * size + c, ch] = w * kernel(ix, iy, n_dot_l, ox, oy, z, P[ch])
+
+
+@numba.njit(cache=True)
+def _scatter(out, index, weight, f):  # pragma: no cover - compiled
+    """out[index[k], c] = weight[k]·f[k, c] (serial: see _lit_pixels)."""
+    for k in range(index.shape[0]):
+        for ch in range(f.shape[1]):
+            out[index[k], ch] = weight[k] * f[k, ch]
+
+
+def _disc(size: int):
+    c = (np.arange(size) + 0.5) / size * 2.0 - 1.0  # x of column c (pixel centre)
+    x = c[None, :]
+    y = -c[:, None]  # y = 1 − (r + ½)/S·2 = −(x of column r)
+    mask = x * x + y * y < 1.0  # strictly inside: N_z > 0
+    return c, mask
+
+
+def sphere_geometry(size: int) -> dict:
+    """Pixel centres, disc mask and normals of an S×S sphere image.
+
+    Returns
+    -------
+    dict
+        ``x`` (S,) and ``y`` (S,): centre coordinates of columns and rows;
+        ``mask`` (S, S) bool; ``normal`` (S, S, 3) with 0 outside the disc.
+    """
+    size = _check_size(size)
+    c, mask = _disc(size)
+    x, y = np.meshgrid(c, -c)
+    nz = np.sqrt(np.maximum(1.0 - x * x - y * y, 0.0))  # the clamp only touches masked pixels
+    normal = np.where(mask[..., None], np.stack([x, y, nz], axis=-1), 0.0)
+    return {"x": c, "y": -c, "mask": mask, "normal": normal}
+
+
+def _check_size(size) -> int:
+    if isinstance(size, bool) or not isinstance(size, int | np.integer) \
+            or not 1 <= size <= MAX_SIZE:
+        raise ParameterError(f"size must be an integer from 1 to {MAX_SIZE} pixels; got "
+                             f"{size!r}")
+    return int(size)
+
+
+def _check_number(value, name: str, *, lower: float = 0.0) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        v = math.nan
+    if not (math.isfinite(v) and v >= lower):
+        raise ParameterError(f"{name} must be a finite number >= {lower:g}; got {value!r}")
+    return v
+
+
+def render_sphere(model: BRDF, *, phi_l: float, ambient: float = 0.0, irradiance: float = 1.0,
+                  size: int = 256, engine: str = "direct",
+                  rho_tol: float = RHO_TOL) -> SphereRender:
+    """Render Lewis's sphere test configuration exactly.
+
+    Parameters
+    ----------
+    model : BRDF
+        Any brdfkit model (registered, pumped, measured, …).
+    phi_l : float, keyword-only
+        Φ_L, the angle between the light and the view direction, radians in
+        [0, π]: the light direction is L = (sin Φ_L, 0, cos Φ_L).
+    ambient : float, keyword-only
+        Uniform ambient radiance L_a ≥ 0 (default 0).
+    irradiance : float, keyword-only
+        E ≥ 0, the light's irradiance on a surface facing it (default 1).
+    size : int, keyword-only
+        Image side S in pixels, 1 … :data:`MAX_SIZE` (default 256).
+    engine : {"direct"}, keyword-only
+        ``direct``: deterministic, exact at pixel centres. (``mitsuba``,
+        Monte Carlo, is not available yet.)
+    rho_tol : float, keyword-only
+        Accuracy goal of ρ(V) when L_a > 0 (see
+        :func:`brdfkit.render.ambient.ambient_table`; cached per model).
+
+    Returns
+    -------
+    SphereRender
+        ``radiance`` (S, S, C), ``mask``, the inputs and the ambient term's
+        error estimate.
+
+    Examples
+    --------
+    >>> import brdfkit, math
+    >>> from brdfkit.render import render_sphere
+    >>> r = render_sphere(brdfkit.model("lambert", rho_d=0.5), phi_l=0.0, size=2)
+    >>> r.radiance.shape
+    (2, 2, 1)
+    """
+    if not isinstance(model, BRDF):
+        hint = (f" (build it first: brdfkit.model({model!r}))" if isinstance(model, str)
+                else "")
+        raise BrdfkitError(f"render_sphere: model must be a brdfkit model (BRDF); got "
+                           f"{type(model).__name__}{hint}")
+    if engine == "mitsuba":
+        raise BrdfkitError("engine 'mitsuba' (Monte Carlo through Mitsuba 3) is not available "
+                           "yet; use engine 'direct' (exact)")
+    if engine not in ENGINES:
+        raise ParameterError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
+    phi = _check_number(phi_l, "phi_l")
+    if phi > math.pi:
+        raise ParameterError(f"phi_l must lie in [0, pi] radians = [0, 180] degrees; got "
+                             f"{phi_l!r} rad")
+    L_a = _check_number(ambient, "ambient")
+    E = _check_number(irradiance, "irradiance")
+    S = _check_size(size)
+    C = model.n_channels or 1
+    L = (math.sin(phi), 0.0, math.cos(phi))
+    out = np.zeros((S * S, C))
+    if E > 0.0 and model.kernel is not None:
+        P = np.ascontiguousarray(np.asarray(model.packed, dtype=np.float64))
+        _direct(model.kernel, S, L[0], L[1], L[2], P, E, out)
+    elif E > 0.0:  # a model evaluated in NumPy (kernel None): directions, then model.eval
+        M = S * S
+        wi, wo = np.empty((M, 3)), np.empty((M, 3))
+        index, cos_l = np.empty(M, dtype=np.int64), np.empty(M)
+        k = _lit_pixels(S, L[0], L[1], L[2], wi, wo, index, cos_l)
+        if k:
+            f = np.asarray(model.eval(wi[:k], wo[:k]), dtype=np.float64).reshape(k, C)
+            _scatter(out, index[:k], E * cos_l[:k], np.ascontiguousarray(f))
+    c, mask = _disc(S)
+    err, msg, ok = 0.0, "", True
+    if L_a > 0.0:
+        # ρ(θ_V) is the same at (±x, ±y): evaluate one quadrant (the first h rows and
+        # columns, h = ⌈S/2⌉) and mirror it; N_z = √(1 − x² − y²) = cos θ_V
+        h = (S + 1) // 2
+        q = c[:h] ** 2
+        r2 = q[:, None] + q[None, :]
+        inside = r2 < 1.0
+        theta_v = np.arccos(np.sqrt(1.0 - r2[inside]))  # θ_V = angle between N and V = ẑ
+        # at least 1e-3 rad: the one pixel of a 1×1 image has θ_V = 0; the table needs a range
+        table = ambient_table(model, theta_max=max(float(np.max(theta_v)), 1e-3), tol=rho_tol)
+        quadrant = np.zeros((h, h, C))
+        quadrant[inside] = L_a * table(theta_v)
+        # mirror: columns (and then rows) 0 … h−1 followed by S − h of them reversed
+        top = np.concatenate([quadrant, quadrant[:, : S - h][:, ::-1]], axis=1)
+        out += np.concatenate([top, top[: S - h][::-1]], axis=0).reshape(S * S, C)
+        err, msg, ok = L_a * table.error, table.message, table.success
+    return SphereRender(radiance=out.reshape(S, S, C), mask=mask, model=model.to_dict(),
+                        phi_l=phi, ambient=L_a, irradiance=E, engine="direct",
+                        ambient_error=err, ambient_message=msg, success=ok)
+
+
+def exposure_phi0(model: BRDF, *, ambient: float = 0.0, irradiance: float = 1.0,
+                  size: int = 256, rho_tol: float = RHO_TOL) -> float:
+    """Lewis's exposure rule: 1/peak of the same scene lit at Φ_L = 0.
+
+    "Incident light for each shader is scaled to produce a peak unsaturated
+    radiance at normal incidence (Φ_L = 0) and then held constant as Φ_L and
+    β are varied" (Lewis 1993, §3.3, Fig. 4). The returned k maps the
+    brightest pixel of the Φ_L = 0 render to display value 1; every render
+    of a series shown with it is comparable.
+
+    Raises
+    ------
+    BrdfkitError
+        The Φ_L = 0 render is black (peak 0): no exposure follows from it.
+    """
+    peak = render_sphere(model, phi_l=0.0, ambient=ambient, irradiance=irradiance, size=size,
+                         rho_tol=rho_tol).peak
+    if not peak > 0.0:
+        raise BrdfkitError("the sphere lit at phi_l = 0 is black (peak radiance 0), so no "
+                           "exposure follows from it; give an explicit exposure")
+    return 1.0 / peak
