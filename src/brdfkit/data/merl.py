@@ -62,6 +62,7 @@ import numba
 import numpy as np
 
 from brdfkit._io import write_atomic
+from brdfkit.data.sampler import TabulatedSampler
 from brdfkit.errors import DataFileError, ParameterError
 from brdfkit.models._base import DerivedBRDF, Lobe, Param, _unit_pair
 
@@ -420,7 +421,7 @@ def _width_from_table(values: np.ndarray) -> float:
     return float(max(th[below[0]], th[0]))
 
 
-class MeasuredBRDF(DerivedBRDF):
+class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
     """A tabulated material on the MERL grid as a brdfkit model.
 
     ======  ========  ===============  ========================================
@@ -445,7 +446,23 @@ class MeasuredBRDF(DerivedBRDF):
     interpolant's albedo).
 
     Reciprocal by construction (the φ_d fold maps the swapped pair to the same
-    bin) and isotropic (φ_h is dropped). Sampling: the cosine fallback.
+    bin) and isotropic (φ_h is dropped).
+
+    Sampling: from the table's own values (:mod:`brdfkit.data.sampler`: per-θ_o
+    bilinear half-vector tables of f̄ cos θ_i mixed with the cosine), built on
+    the first ``sample``/``pdf`` (~50 ms); the density is positive on the whole
+    upper hemisphere, unmeasured bins included.
+
+    Plausibility verdicts (:func:`brdfkit.analysis.check`) on measured data:
+    *reciprocal* is a property of the lookup, not of the measurement — MERL
+    stores one value per (θ_h, θ_d, φ_d mod π) bin, and swapping ω_i and ω_o
+    only flips φ_d by π, so every table is reciprocal whatever was measured
+    (a verdict about the storage, not evidence that the material is). *Energy*:
+    a ``nearest`` table's albedo does not converge to the engine's tolerance
+    (jumps at bin edges), so the verdict is ``undetermined`` when the maximum
+    albedo lies within its error estimate of 1 and otherwise reflects the
+    table's albedo ± that error; unmeasured bins make the albedo NaN where they
+    are reached and the verdict ``undetermined`` (no value is invented for them).
     """
 
     def __init__(self, table: MerlTable, *, name: str | None = None, lookup: str = "nearest",
@@ -466,7 +483,7 @@ class MeasuredBRDF(DerivedBRDF):
                                       doc="nearest bin (reference reader) or trilinear"),),
             values={"lookup": lookup}, citation=citation,
             summary=f"tabulated material ({table.source}), MERL grid 90x90x180",
-            reciprocal=True, has_sampler=False, kernel=_measured_kernel)
+            reciprocal=True, has_sampler=True, kernel=_measured_kernel)
         self.n_channels = 3
         self._driver = _measured_driver  # one bin computation per pair for all channels
 
