@@ -36,14 +36,14 @@ N_SAMPLES = 100_000
 ALPHA = 0.01
 PHI_O = math.radians(23.0)
 
-#: (material, θ_o in degrees): sharp metal at normal and oblique view, a diffuse NBRDF, one
+#: (material, θ_o in degrees): a sharp metal at normal view, a diffuse NBRDF, one
 #: fit of each other representation, an RGL and a Nielsen material, grazing views
-SURROGATE_CASES = [("merl:nickel", 0.0), ("merl:nickel", 60.0), ("merl:violet-rubber", 45.0),
+SURROGATE_CASES = [("merl:nickel", 0.0), ("merl:violet-rubber", 45.0),
                    ("merl:gray-plastic@abc", 85.0), ("merl:nickel@sgd", 30.0),
                    ("merl:blue-metallic-paint@npf", 70.0), ("rgl:spectralon", 40.0),
                    ("nielsen:bluebook", 80.0)]
 MEASURED_THETAS = (30.0, 75.0)
-N_TESTS = len(SURROGATE_CASES) + len(MEASURED_THETAS) + 2
+N_TESTS = len(SURROGATE_CASES) + len(MEASURED_THETAS) + 1
 
 
 def wo_at(theta_deg: float) -> np.ndarray:
@@ -57,11 +57,12 @@ def seed_for(*parts) -> int:
 
 @pytest.fixture(scope="module")
 def glossy_file(tmp_path_factory):
-    """A MERL file of our own making: a glossy GGX microfacet material tabulated at the bin
-    centres, written as a real .binary file and read back."""
-    m = brdfkit.model("microfacet", distribution="ggx", alpha=0.15)
-    path = tmp_path_factory.mktemp("merl") / "ggx.binary"
-    write_binary(path, table_from_function(m.eval, source="ggx"))
+    """A MERL file of our own making: Lewis's glossy Phong (not reciprocal) tabulated at the
+    bin centres, written as a real .binary file and read back. One table for every test
+    here (tabulating costs ~1.5 M evaluations)."""
+    m = brdfkit.model("phong")
+    path = tmp_path_factory.mktemp("merl") / "phong.binary"
+    write_binary(path, table_from_function(m.eval, source="phong"))
     return path
 
 
@@ -70,7 +71,7 @@ def glossy_file(tmp_path_factory):
 def test_measured_table_sampler_matches_pdf(glossy_file, theta):
     m = MeasuredBRDF(read_binary(glossy_file))
     assert m.has_sampler
-    r = chi2_test(m, wo_at(theta), n_samples=N_SAMPLES, seed=seed_for("ggx", theta),
+    r = chi2_test(m, wo_at(theta), n_samples=N_SAMPLES, seed=seed_for("phong", theta),
                   alpha=ALPHA, n_tests=N_TESTS)
     assert r.passed, f"θo={theta}°: {r.message}"
     assert r.dof >= 50 and r.pdf_integral <= 1.0 + 1e-3
@@ -117,7 +118,7 @@ def test_bilinear_table_is_exact_for_a_linear_density():
                                rtol=1e-12)
 
 
-@pytest.mark.parametrize("theta", [10.0, 65.0])
+@pytest.mark.parametrize("theta", [65.0])
 def test_tabulated_strategy_alone(theta):
     r = chi2_test(_Linear(), wo_at(theta), n_samples=N_SAMPLES, seed=seed_for("lin", theta),
                   alpha=ALPHA, n_tests=N_TESTS)
@@ -132,13 +133,19 @@ def test_wrong_table_pdf_fails():
 
 
 def test_sampled_albedo_is_unbiased(glossy_file):
-    # MC albedo through the sampler vs the deterministic engine (linear lookup: converges),
-    # within 5 standard errors
+    # MC albedo through the sampler vs the deterministic engine (linear lookup: continuous)
+    # and vs the half-vector quadrature below (independent, all azimuths), within 5σ. The
+    # table of a non-reciprocal model is not even in φ (bin φ_d ≠ bin 179 − φ_d), declares
+    # isotropic False, and the engine integrates all azimuths (halving was 1 % off here).
     m = MeasuredBRDF(read_binary(glossy_file), lookup="linear")
+    assert not m.isotropic
     t = np.radians([20.0, 60.0])
-    mc = albedo_mc(m, t, n_samples=40_000, rng=11)
-    ref = albedo(m, t, tol=1e-5)
+    mc = albedo_mc(m, t, n_samples=20_000, rng=11)
+    ref = albedo(m, t, tol=1e-4)
     assert np.all(np.abs(mc.albedo - ref.albedo) <= 5 * mc.error + 1e-4), (mc, ref)
+    for k in range(2):
+        q = half_vector_albedo(m, t[k], width=m.sharpest_lobe().width)
+        np.testing.assert_allclose(ref.albedo[k], q, rtol=2e-3)
 
 
 # ----------------------------------------------------------------- albedo: a second quadrature
@@ -205,23 +212,15 @@ def test_albedo_against_half_vector_quadrature(spec, half, rtol):
 
 
 # ----------------------------------------------------------------- plausibility of measured data
-def test_merl_tables_are_reciprocal_by_the_fold():
+def test_check_on_a_measured_table(glossy_file):
     # Lewis's Phong is not reciprocal (max asymmetry ~1); its MERL tabulation is: the
     # swapped pair lands in the same (θ_h, θ_d, φ_d mod π) bin. With the linear lookup the
-    # asymmetry is rounding; NaN pairs (unmeasured bins at grazing) are left out.
-    phong = brdfkit.model("phong")
-    assert reciprocity(phong) > 0.1
-    assert reciprocity(MeasuredBRDF(table_from_function(phong.eval), lookup="linear")) < 1e-12
-
-
-def test_check_on_a_measured_table():
-    # the verdict of a table of a reciprocal, energy-conserving model (modified Phong,
-    # ρ_d + ρ_s ≤ 1): reciprocal; unmeasured bins (below the horizon at the bin centre) are
-    # reached by the grazing albedos, so no energy verdict is invented: 'undetermined', and
-    # the notes say which pairs and angles had no value
-    m = MeasuredBRDF(table_from_function(
-        brdfkit.model("modified-phong", rho_d=0.3, rho_s=0.5, n=20.0).eval), lookup="linear")
-    v = check(m, tol=1e-5)
+    # asymmetry is rounding; pairs with a NaN (unmeasured bins at grazing) are left out and
+    # counted in the notes. The grazing albedos reach unmeasured bins (below the horizon
+    # at the bin centre), so no energy verdict is invented: 'undetermined'.
+    assert reciprocity(brdfkit.model("phong")) > 0.1
+    m = MeasuredBRDF(read_binary(glossy_file), lookup="linear")
+    v = check(m, tol=1e-3)  # tol: the reciprocity pairs do not depend on it (CI time)
     assert v.reciprocity == "reciprocal" and v.reciprocal and v.max_asymmetry < 1e-12
     assert any("have no value (NaN)" in n for n in v.notes)
     assert v.energy == "undetermined" and any("NaN" in n for n in v.notes)

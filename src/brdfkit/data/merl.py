@@ -421,6 +421,19 @@ def _width_from_table(values: np.ndarray) -> float:
     return float(max(th[below[0]], th[0]))
 
 
+def _mirror_symmetric(values: np.ndarray) -> bool:
+    """Whether the table is even in the relative azimuth: f(ω_i, ω_o) = f(ω_i', ω_o') for
+    the pair mirrored in the plane of incidence. The mirror maps φ_d to −φ_d, which the
+    lookup folds to π − φ_d: bin i_φd ↔ 179 − i_φd (nearest) and bin centre ↔ bin centre
+    (linear). Compared to 1e-9 relative — the rounding of a tabulated symmetric function,
+    far below any measurement's noise; unmeasured bins must be unmeasured in both."""
+    v = values.reshape(3, 90, 90, 180)
+    m = v[..., ::-1]
+    with np.errstate(invalid="ignore"):
+        close = np.abs(v - m) <= 1e-9 * np.maximum(np.abs(v), np.abs(m))
+    return bool(np.all(close | (np.isnan(v) & np.isnan(m))))
+
+
 class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
     """A tabulated material on the MERL grid as a brdfkit model.
 
@@ -446,7 +459,15 @@ class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
     interpolant's albedo).
 
     Reciprocal by construction (the φ_d fold maps the swapped pair to the same
-    bin) and isotropic (φ_h is dropped).
+    bin); f depends on the azimuths only through φ_i − φ_o (φ_h is dropped), and
+    is even in it — ``isotropic`` True, so the albedo engine integrates half the
+    azimuths — only when the table equals its mirror image, bin φ_d ↔ bin
+    179 − φ_d (:func:`_mirror_symmetric`; a mirrored pair's φ_d folds to
+    π − φ_d). A table of a reciprocal isotropic function is; a table of a
+    non-reciprocal one (each bin holds f(ω_i, ω_o) of its own centre only) or a
+    noisy measurement is not, and declares ``isotropic`` False (the engine then
+    integrates all azimuths: halving cost 1.1 % of the albedo of a tabulated
+    Lewis Phong at θ_i = 20° while reporting 3e-6 error).
 
     Sampling: from the table's own values (:mod:`brdfkit.data.sampler`: per-θ_o
     bilinear half-vector tables of f̄ cos θ_i mixed with the cosine), built on
@@ -483,7 +504,8 @@ class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
                                       doc="nearest bin (reference reader) or trilinear"),),
             values={"lookup": lookup}, citation=citation,
             summary=f"tabulated material ({table.source}), MERL grid 90x90x180",
-            reciprocal=True, has_sampler=True, kernel=_measured_kernel)
+            reciprocal=True, has_sampler=True, kernel=_measured_kernel,
+            isotropic=_mirror_symmetric(values))
         self.n_channels = 3
         self._driver = _measured_driver  # one bin computation per pair for all channels
 
