@@ -29,7 +29,7 @@ from brdfkit.analysis.chi2 import chi2_test
 from brdfkit.analysis.plausibility import reciprocity
 from brdfkit.data.merl import MeasuredBRDF, read_binary, table_from_function, write_binary
 from brdfkit.models.diffuse import Lambert
-from brdfkit.models.sampling import HalfVector, Mixture, PowerHalf, StrategySampled
+from brdfkit.models.sampling import HalfVector, PowerHalf, StrategySampled
 from brdfkit.models.tabulated_sampling import TabulatedHalfVector, sample_linear
 
 N_SAMPLES = 100_000
@@ -232,3 +232,21 @@ def test_surrogate_reciprocity_as_declared():
     assert reciprocity(bd.material("merl:violet-rubber")) > 0.01
     for spec in ("merl:nickel@abc", "merl:gray-plastic@sgd"):
         assert reciprocity(bd.material(spec)) <= 1e-6, spec
+
+
+def test_npf_asymmetry_is_bin_edge_rounding():
+    # NPF is symmetric in θ_i, θ_o by its formula; its nearest-bin D and F lookups can
+    # round θ_d (from ω_i or from ω_o) to neighbouring bins on a bin edge. The check's
+    # structured pair set hits such an edge (θ_i = 15°, θ_o = 89°, Δφ = 180°); the same
+    # pair 1e-4° away is symmetric to rounding.
+    m = bd.material("merl:violet-rubber@npf")
+
+    def d(theta, phi):
+        t, p = math.radians(theta), math.radians(phi)
+        return np.array([math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t)])
+
+    for eps, expect_asym in ((0.0, True), (1e-4, False)):
+        L, V = d(15.0 + eps, eps), d(89.0 + 2 * eps, 180.0 + eps)
+        a, b = m.eval(L, V), m.eval(V, L)
+        rel = float(np.max(np.abs(a - b) / np.maximum(a, b)))
+        assert (rel > 1e-3) == expect_asym and (expect_asym or rel < 1e-12), (eps, rel)

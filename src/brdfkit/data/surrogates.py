@@ -522,7 +522,12 @@ class SurrogateBRDF(TabulatedSampler, DerivedBRDF):
 
     Plausibility verdicts (:func:`brdfkit.analysis.check`) are verdicts on the
     surrogate, not on the measurement: NPF, ABC and SGD are reciprocal by their
-    form (functions of θ_h, θ_d and symmetric in θ_i, θ_o); NBRDF is declared
+    form (functions of θ_h, θ_d and symmetric in θ_i, θ_o) — but NPF reads D and F
+    at the *nearest* bin, and θ_d computed from ω_i or from ω_o can round to
+    neighbouring bins when it lies on a bin edge: ``check`` finds up to ~2 %
+    asymmetry at such pairs of its set (violet-rubber@npf: θ_i = 15°,
+    θ_o = 89°, Δφ = 180°) and 3e-16 a 1e-4° step away — its "not reciprocal"
+    is this rounding on bin edges, not the fit's form. NBRDF is declared
     and found non-reciprocal — the net learns f from ω_i's difference vector and
     nothing ties f(ω_i, ω_o) to f(ω_o, ω_i), so its asymmetry (1–30 % median by
     material) is a fitting artefact, not a property of the material. Energy:
