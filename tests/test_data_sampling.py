@@ -118,6 +118,21 @@ def test_bilinear_table_is_exact_for_a_linear_density():
                                rtol=1e-12)
 
 
+def test_tables_validate_their_arguments():
+    from brdfkit.data.sampler import tabulated_strategy
+    from brdfkit.errors import ParameterError
+
+    th, psi = np.radians([0.0, 10.0, 90.0]), np.array([0.0, math.pi])
+    with pytest.raises(ParameterError, match=r"values must have shape \(1, 3, 2\)"):
+        TabulatedHalfVector([0.0], th, psi, np.ones((1, 2, 2)))
+    with pytest.raises(ParameterError, match="theta_h must be increasing"):
+        TabulatedHalfVector([0.0], th[::-1], psi, np.ones((1, 3, 2)))
+    with pytest.raises(ParameterError, match="finite and >= 0"):
+        TabulatedHalfVector([0.0], th, psi, -np.ones((1, 3, 2)))
+    with pytest.raises(ParameterError, match=r"cosine_weight must lie in \(0, 1\]; got 0"):
+        tabulated_strategy(bd.material("merl:nickel@abc"), cosine_weight=0)
+
+
 @pytest.mark.parametrize("theta", [65.0])
 def test_tabulated_strategy_alone(theta):
     r = chi2_test(_Linear(), wo_at(theta), n_samples=N_SAMPLES, seed=seed_for("lin", theta),
