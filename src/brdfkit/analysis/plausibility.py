@@ -9,6 +9,8 @@ whether it conserves energy (Lewis §4–5, Neumann §2):
   |f(L,V) − f(V,L)| / max(f(L,V), f(V,L)) over a structured set of pairs
   (θ ∈ {0, 15, 30, 45, 60, 75, 85, 89, 89.9}°, both directions, five relative
   azimuths including the mirror configuration). Reciprocal when ≤ 1e-6.
+  Pairs where f is NaN in either order (unmeasured bins of a measured table)
+  are left out and counted in the notes; *undetermined* when none is left.
 - **Energy** — the albedo a(θ_i) on 0…87° in 3° steps plus
   89°, 89.5°, 89.9°, 89.99°, 89.999°, refined about its maximum.
   *diverges*: a grows without bound as θ_i → 90°; the rate p of
@@ -80,6 +82,9 @@ class Verdict:
     theta_min_deg: float = 0.0
     #: The pumping stages of a pumped model (``PumpedBRDF.to_dict()["pump"]``), else None.
     pump: dict | list | None = None
+    #: "reciprocal", "not reciprocal", or "undetermined" (no pair with both values);
+    #: ``reciprocal`` is True only for the first.
+    reciprocity: str = ""
 
     def to_dict(self) -> dict:
         """JSON-ready dict with the keys of ``brdfkit check --json``."""
@@ -87,6 +92,7 @@ class Verdict:
             "model": self.model,
             "params": self.params,
             "reciprocal": bool(self.reciprocal),
+            "reciprocity": self.reciprocity,
             "max_asymmetry": float(self.max_asymmetry),
             "energy": self.energy,
             "max_albedo": float(self.max_albedo),
@@ -111,17 +117,30 @@ def _dirs(theta_deg, phi_deg) -> np.ndarray:
     return np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], axis=-1)
 
 
-def reciprocity(model) -> float:
-    """Largest relative asymmetry |f(L,V) − f(V,L)| / max(f(L,V), f(V,L)) over the pair set."""
+def _reciprocity(model) -> tuple[float, int, int]:
+    """(asymmetry over the pairs where both values exist, pairs without both, all pairs)."""
     ti, to, dp = np.meshgrid(_PAIR_THETA_DEG, _PAIR_THETA_DEG, _PAIR_DPHI_DEG, indexing="ij")
     L = _dirs(ti.ravel(), np.zeros(ti.size))
     V = _dirs(to.ravel(), dp.ravel())
     a = evaluate_pairs(model, L, V)
     b = evaluate_pairs(model, V, L)
+    # a NaN value (e.g. an unmeasured bin of a measured table) is no evidence either way:
+    # such pairs are left out and counted, never compared
+    both = np.all(np.isfinite(a) & np.isfinite(b), axis=-1)
+    n_missing = int(np.count_nonzero(~both))
+    if not np.any(both):
+        return float("nan"), n_missing, both.size
+    a, b = a[both], b[both]
     scale = max(float(np.max(np.abs(a))), float(np.max(np.abs(b))), 1e-300)
     # floor: pairs where both values are ~1e-12 of the largest are rounding noise
     den = np.maximum(np.maximum(np.abs(a), np.abs(b)), 1e-12 * scale)
-    return float(np.max(np.abs(a - b) / den))
+    return float(np.max(np.abs(a - b) / den)), n_missing, both.size
+
+
+def reciprocity(model) -> float:
+    """Largest relative asymmetry |f(L,V) − f(V,L)| / max(f(L,V), f(V,L)) over the pair set
+    (pairs where a value is NaN left out; NaN when no pair has both values)."""
+    return _reciprocity(model)[0]
 
 
 def divergence_rate(values: np.ndarray, theta_deg=GRAZING_DEG) -> list[float]:
@@ -178,12 +197,20 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
         raise BrdfkitError(f"check: model must be a brdfkit model (BRDF); got "
                            f"{type(model).__name__} {model!r}{hint}")
     d = model.to_dict()
-    asym = reciprocity(model)
+    asym, n_missing, n_pairs = _reciprocity(model)
+    if not math.isfinite(asym):
+        recip = "undetermined"
+    else:
+        recip = "reciprocal" if asym <= RECIPROCITY_TOL else "not reciprocal"
     grid = np.concatenate([np.arange(0.0, 87.01, 3.0), [89.0, 89.5], GRAZING_DEG[1:]])
     r = albedo(model, np.radians(grid), tol=tol)
     a = np.asarray(r.albedo).reshape(grid.size, -1)
     err = float(np.max(np.asarray(r.error)))
     notes: list[str] = []
+    if n_missing:
+        notes.append(f"reciprocity {'undetermined' if recip == 'undetermined' else 'judged'}"
+                     f": {n_missing} of {n_pairs} pairs have no value (NaN) in one order and "
+                     "were left out")
     if not r.success:
         notes.append(f"albedo not computed to the tolerance {tol:g}: {r.message}")
     if not np.all(np.isfinite(a)):
@@ -192,7 +219,7 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
             model=d["model"], params=d["params"], reciprocal=bool(asym <= RECIPROCITY_TOL),
             max_asymmetry=asym, energy="undetermined", max_albedo=float("nan"),
             theta_max_deg=float("nan"), divergence_exponent=None, max_scale=None, notes=notes,
-            albedo_error=float("inf"), pump=d.get("pump"))
+            albedo_error=float("inf"), pump=d.get("pump"), reciprocity=recip)
 
     # --- divergence from the asymptotics, per channel
     ig = [int(np.argmin(np.abs(grid - g))) for g in GRAZING_DEG]
@@ -264,7 +291,7 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
         if a_graze < 0.5 * max_a:
             notes.append(f"dark at grazing incidence: a(89.9 deg) = {a_graze:.3g}, "
                          f"{100 * a_graze / max_a:.2g}% of its maximum (Neumann §1.2)")
-    if not asym <= RECIPROCITY_TOL:
+    if recip == "not reciprocal":
         notes.append(f"not reciprocal: max relative asymmetry {asym:.3g}")
     if model.has_delta:
         notes.append("includes the energy of the specular delta term (specular_albedo)")
@@ -277,5 +304,5 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
         divergence_exponent=p_rounded, max_scale=max_scale, notes=notes, grazing=grazing,
         slopes=slopes_worst, peaks_at_normal=peaks, albedo_error=err,
         min_albedo=float(a.min(axis=1)[kmin]), theta_min_deg=float(grid[kmin]),
-        pump=d.get("pump"),
+        pump=d.get("pump"), reciprocity=recip,
     )
