@@ -43,7 +43,7 @@ from __future__ import annotations
 
 import math
 from collections import OrderedDict
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numba
@@ -69,9 +69,9 @@ class SphereRender:
     Attributes
     ----------
     radiance : ndarray (S, S, C)
-        Linear radiance, in the units of E and L_a per steradian-free unit of
-        f_r (E in W/m² and L_a in W/(m²·sr) give W/(m²·sr)); C = the model's
-        channel count (1 for a scalar model). 0 outside the disc.
+        Linear radiance in the units of L_a (f_r is in 1/sr: E in W/m² and L_a
+        in W/(m²·sr) give W/(m²·sr)); C = the model's channel count (1 for a
+        scalar model). 0 outside the disc.
     mask : ndarray of bool (S, S)
         The disc: pixels whose centre lies on the sphere.
     model : dict
@@ -101,7 +101,6 @@ class SphereRender:
     ambient_error: float = 0.0
     ambient_message: str = ""
     success: bool = True
-    extra: dict = field(default_factory=dict)
 
     @property
     def size(self) -> int:
