@@ -51,6 +51,21 @@ if [ -n "$extra" ] || [ "${BRDFKIT_SYSTEM_DEPS:-0}" = 1 ]; then
   fi
 fi
 
+# System part for the explorer's browser tests (--test/--dev): Debian's chromium, driven by
+# Playwright with executable_path (Playwright cannot download browsers here).
+if [ -n "$extra" ]; then
+  if command -v chromium >/dev/null 2>&1; then
+    :
+  elif [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+    echo "setup.sh: installing chromium (apt) for the explorer's browser tests"
+    apt-get install -y -q chromium >/dev/null 2>&1 \
+      || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q chromium >/dev/null; } \
+      || echo "setup.sh: warning: could not install chromium; the browser tests will be skipped (with this reason)" >&2
+  else
+    echo "setup.sh: note: chromium is missing and this is not root with apt-get; the explorer's browser tests will be skipped. Fix: sudo apt-get install chromium" >&2
+  fi
+fi
+
 .venv/bin/python -m pip install -q --upgrade pip
 .venv/bin/python -m pip install -q -e ".${extra}"
 .venv/bin/python -c "import brdfkit; print('setup.sh: brdfkit', brdfkit.__version__, 'ready in .venv/')"

@@ -411,12 +411,13 @@ def _imports(path: pathlib.Path) -> set[str]:
 
 
 def test_figure_modules_import_downward_only():
-    for name in ("lewis", "neumann", "pumping"):
+    for name in ("lewis", "lewis_spheres", "neumann", "pumping"):
         imported = _imports(SRC / "figures" / f"{name}.py")
         assert not {m for m in imported if m.startswith("brdfkit.figures")}, (name, imported)
     assert not {m for m in _imports(SRC / "figures" / "_save.py")
                 if m.startswith("brdfkit.figures")}
-    assert set(FIGURES) == {"lewis-fig5", "lewis-fig7", "lewis-fig8", "lewis-fig9",
+    assert set(FIGURES) == {"lewis-fig3", "lewis-fig4", "lewis-fig5", "lewis-fig6",
+                            "lewis-fig7", "lewis-fig8", "lewis-fig9", "lewis-fig10",
                             "neumann-fig1", "neumann-fig3", "neumann-fig4", "neumann-fig5",
                             "neumann-fig6", "neumann-fig7"}
 
@@ -427,7 +428,9 @@ def test_cli_command_modules_do_not_import_the_cli_package():
             continue
         bad = {m for m in _imports(path) if m in ("brdfkit.cli", "brdfkit.cli.main")}
         assert not bad, (path.name, bad)
-    assert set(main.commands) == {"models", "eval", "albedo", "check", "table2", "figure"}
+    assert set(main.commands) == {"models", "eval", "albedo", "check", "table2", "figure",
+                                  "render"}
+    assert set(main.commands["render"].commands) == {"sphere"}
 
 
 def test_cli_has_no_self_guarding_imports_and_one_brdfkit_error_handler():

@@ -182,7 +182,9 @@ def check_cmd(model, param, pump, times, as_json):
         emit_json(d)
         return
     click.echo(f"model:        {d['model']}  {d['params']}")
-    click.echo(f"reciprocal:   {'yes' if d['reciprocal'] else 'no'} "
+    recip = {"reciprocal": "yes", "not reciprocal": "no"}.get(d["reciprocity"],
+                                                                d["reciprocity"] or "no")
+    click.echo(f"reciprocal:   {recip} "
                f"(max relative asymmetry {d['max_asymmetry']:.3g})")
     energy = d["energy"]
     if energy == "diverges":

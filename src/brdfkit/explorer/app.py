@@ -28,8 +28,6 @@ Bokeh document model, and the page stays plain HTML that Playwright drives
 directly (no shadow DOM).
 """
 
-from __future__ import annotations
-
 import base64
 import json
 import math
@@ -38,6 +36,9 @@ import time
 from collections import OrderedDict
 from importlib import resources
 from pathlib import Path
+
+from fastapi import FastAPI, Request
+from fastapi.responses import HTMLResponse, JSONResponse, Response
 
 from brdfkit._specs import model as build_spec
 from brdfkit.data import material_names
@@ -49,7 +50,7 @@ from brdfkit.pumping import MAX_TIMES, pump
 
 __all__ = ["create_app", "build_entry", "parse_state"]
 
-_CACHE_SIZE = 32
+_CACHE_SIZE = 64
 
 
 def _number(state: dict, key: str, default: float, lo: float, hi: float) -> float:
@@ -106,28 +107,47 @@ def build_entry(entry: dict):
     return pump(m, g=g, times=times)
 
 
+async def _body(request: Request):
+    """The request's JSON body, or a BrdfkitError saying what was wrong with it."""
+    try:
+        return json.loads(await request.body())
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise BrdfkitError(f"the request body must be JSON (the explorer state): {exc}") from None
+
+
 def _b64(png: bytes) -> str:
     return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
 
 
 def create_app():
     """The FastAPI application (one model cache per app)."""
-    from fastapi import FastAPI, Request
-    from fastapi.responses import HTMLResponse, JSONResponse, Response
-
     app = FastAPI(title="brdfkit explorer", docs_url=None, redoc_url=None)
-    cache: OrderedDict[str, object] = OrderedDict()
+    cache: OrderedDict = OrderedDict()
     static = resources.files("brdfkit.explorer") / "static"
 
-    def get_model(entry: dict):
-        key = json.dumps({k: entry.get(k) for k in ("spec", "params", "pump", "times")},
-                         sort_keys=True)
+    def _key(entry: dict) -> str:
+        return json.dumps({k: entry.get(k) for k in ("spec", "params", "pump", "times")},
+                          sort_keys=True)
+
+    def _cached(key, make):
         if key not in cache:
-            cache[key] = build_entry(entry)
+            cache[key] = make()
             if len(cache) > _CACHE_SIZE:
                 cache.popitem(last=False)
         cache.move_to_end(key)
         return cache[key]
+
+    def get_model(entry: dict):
+        return _cached(_key(entry), lambda: build_entry(entry))
+
+    def model_only(entry: dict, m, mode: str) -> dict:
+        """Views that depend on the model alone (not on the direction or the light):
+        computed once per model and channel mode, so moving θ_i, φ_i or Φ_L skips them."""
+        def make():
+            png_h, hd = views.halfdiff(m)
+            return {"albedo": views.albedo_curve(m, mode=mode), "halfdiff": _b64(png_h),
+                    "halfdiff_info": hd}
+        return _cached(_key(entry) + "|views|" + mode, make)
 
     @app.exception_handler(BrdfkitError)
     async def _brdfkit_error(request: Request, exc: BrdfkitError):
@@ -141,6 +161,10 @@ def create_app():
     @app.get("/", response_class=HTMLResponse)
     def index():
         return (static / "index.html").read_text(encoding="utf-8")
+
+    @app.get("/favicon.ico")
+    def favicon():
+        return Response(status_code=204)
 
     @app.get("/static/{name}")
     def static_file(name: str):
@@ -156,14 +180,13 @@ def create_app():
 
     @app.post("/api/views")
     async def all_views(request: Request):
-        s = parse_state(await request.json())
+        s = parse_state(await _body(request))
         t0 = time.perf_counter()
         out = []
         for entry in s["models"]:
             try:
                 m = get_model(entry)
                 png_s, sph = views.sphere(m, phi_l=s["phi_l"], ambient=s["ambient"])
-                png_h, hd = views.halfdiff(m)
                 out.append({
                     "spec": entry.get("spec"), "name": m.name, "params": m.to_dict()["params"],
                     "polar": views.polar(m, s["theta_i"], s["phi_i"], cosine=s["cosine"],
@@ -171,10 +194,9 @@ def create_app():
                     "lobe": views.lobe(m, s["theta_i"], s["phi_i"]),
                     "curves": views.curves(m, s["theta_i"], s["phi_i"], cosine=s["cosine"],
                                            mode=s["mode"]),
-                    "albedo": views.albedo_curve(m, mode=s["mode"]),
                     "sphere": _b64(png_s), "sphere_info": sph,
-                    "halfdiff": _b64(png_h), "halfdiff_info": hd,
                     "reciprocal_claim": m.reciprocal,
+                    **model_only(entry, m, s["mode"]),
                 })
             except BrdfkitError as exc:
                 out.append({"spec": entry.get("spec"), "error": str(exc)})
@@ -182,7 +204,7 @@ def create_app():
 
     @app.post("/api/verdict")
     async def verdicts(request: Request):
-        s = parse_state(await request.json())
+        s = parse_state(await _body(request))
         out = []
         for entry in s["models"]:
             try:
@@ -193,7 +215,7 @@ def create_app():
 
     @app.post("/api/export/binary")
     async def export_binary(request: Request):
-        entry = await request.json()
+        entry = await _body(request)
         m = get_model(entry)
         with tempfile.TemporaryDirectory() as d:
             path = Path(d) / "model.binary"

@@ -28,7 +28,6 @@ counts, the value itself for grey models) or ``"rgb"`` (each channel).
 
 from __future__ import annotations
 
-import io
 import math
 
 import numpy as np
@@ -126,12 +125,10 @@ def _colormap(u: np.ndarray) -> np.ndarray:
 
 
 def png_bytes(rgb: np.ndarray) -> bytes:
-    """uint8 (H, W, 3) → PNG file bytes."""
-    from matplotlib.image import imsave
+    """uint8 (H, W, 3) → PNG file bytes (the renderer's own encoder, fast zlib level)."""
+    from brdfkit.render.image import png_bytes as encode
 
-    buf = io.BytesIO()
-    imsave(buf, np.ascontiguousarray(rgb), format="png")
-    return buf.getvalue()
+    return encode(np.ascontiguousarray(rgb, dtype=np.uint8))
 
 
 def halfdiff(model, *, size: int = 90, phi_d: float = 0.5 * math.pi, decades: float = 4.0):

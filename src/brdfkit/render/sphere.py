@@ -42,7 +42,9 @@ References
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from collections import OrderedDict
+from dataclasses import dataclass
+from functools import lru_cache
 
 import numba
 import numpy as np
@@ -67,9 +69,9 @@ class SphereRender:
     Attributes
     ----------
     radiance : ndarray (S, S, C)
-        Linear radiance, in the units of E and L_a per steradian-free unit of
-        f_r (E in W/m² and L_a in W/(m²·sr) give W/(m²·sr)); C = the model's
-        channel count (1 for a scalar model). 0 outside the disc.
+        Linear radiance in the units of L_a (f_r is in 1/sr: E in W/m² and L_a
+        in W/(m²·sr) give W/(m²·sr)); C = the model's channel count (1 for a
+        scalar model). 0 outside the disc.
     mask : ndarray of bool (S, S)
         The disc: pixels whose centre lies on the sphere.
     model : dict
@@ -99,7 +101,6 @@ class SphereRender:
     ambient_error: float = 0.0
     ambient_message: str = ""
     success: bool = True
-    extra: dict = field(default_factory=dict)
 
     @property
     def size(self) -> int:
@@ -167,8 +168,8 @@ def _lit_pixels(size, lx, ly, lz, wi, wo, index, cos_l):  # pragma: no cover - c
 # image directly, with no arrays of directions in between.
 @numba.njit
 def _direct(kernel, size, lx, ly, lz, P, E, out):  # pragma: no cover - compiled
-    """out[r·S + c, ch] = E·kernel(wi, wo, P[ch])·(N·L) at the lit disc pixels (frames as
-    in :func:`_lit_pixels`); other rows of *out* are left as they are (zeros)."""
+    """out[r·S + c, ch] += E·kernel(wi, wo, P[ch])·(N·L) at the lit disc pixels (frames as
+    in :func:`_lit_pixels`); other rows of *out* are left as they are."""
     for r in range(size):
         for c in range(size):
             x, y, z, n_dot_l = _pixel(size, r, c, lx, ly, lz)
@@ -181,15 +182,57 @@ def _direct(kernel, size, lx, ly, lz, P, E, out):  # pragma: no cover - compiled
             oy = -y / s
             w = E * n_dot_l
             for ch in range(P.shape[0]):
-                out[r * size + c, ch] = w * kernel(ix, iy, n_dot_l, ox, oy, z, P[ch])
+                out[r * size + c, ch] += w * kernel(ix, iy, n_dot_l, ox, oy, z, P[ch])
 
 
 @numba.njit(cache=True)
 def _scatter(out, index, weight, f):  # pragma: no cover - compiled
-    """out[index[k], c] = weight[k]·f[k, c] (serial: see _lit_pixels)."""
+    """out[index[k], c] += weight[k]·f[k, c] (serial: see _lit_pixels)."""
     for k in range(index.shape[0]):
         for ch in range(f.shape[1]):
-            out[index[k], ch] = weight[k] * f[k, ch]
+            out[index[k], ch] += weight[k] * f[k, ch]
+
+
+@lru_cache(maxsize=16)
+def _max_r2(size: int) -> float:
+    """Largest x² + y² of a pixel centre inside the disc (the outermost pixel)."""
+    c, mask = _disc(size)
+    r2 = c[None, :] ** 2 + c[:, None] ** 2
+    return float(np.max(r2[mask]))
+
+
+#: The last few ρ(θ_V) images, keyed by (id(table), S): the ambient image does not depend
+#: on Φ_L or E, so a series of renders of one model reuses it (each entry keeps its table
+#: alive, so an id is never reused while its entry exists). 4 entries: ≤ 25 MB at 512², RGB.
+_RHO_IMAGES: OrderedDict = OrderedDict()
+_RHO_IMAGES_MAX = 4
+
+
+def _rho_image(table, S: int, C: int) -> np.ndarray:
+    """ρ(θ_V) at every pixel, (S·S, C), 0 outside the disc (read-only, cached)."""
+    key = (id(table), S)
+    hit = _RHO_IMAGES.get(key)
+    if hit is not None and hit[0] is table:
+        _RHO_IMAGES.move_to_end(key)
+        return hit[1]
+    # ρ(θ_V) is the same at (±x, ±y): evaluate one quadrant (the first h rows and columns,
+    # h = ⌈S/2⌉) and mirror it; N_z = √(1 − x² − y²) = cos θ_V
+    c, _ = _disc(S)
+    h = (S + 1) // 2
+    q = c[:h] ** 2
+    r2 = q[:, None] + q[None, :]
+    inside = r2 < 1.0
+    theta_v = np.arccos(np.sqrt(1.0 - r2[inside]))  # θ_V = angle between N and V = ẑ
+    quadrant = np.zeros((h, h, C))
+    quadrant[inside] = table(theta_v)
+    # mirror: columns (and then rows) 0 … h−1 followed by S − h of them reversed
+    top = np.concatenate([quadrant, quadrant[:, : S - h][:, ::-1]], axis=1)
+    image = np.concatenate([top, top[: S - h][::-1]], axis=0).reshape(S * S, C)
+    image.flags.writeable = False
+    _RHO_IMAGES[key] = (table, image)
+    if len(_RHO_IMAGES) > _RHO_IMAGES_MAX:
+        _RHO_IMAGES.popitem(last=False)
+    return image
 
 
 def _disc(size: int):
@@ -293,7 +336,15 @@ def render_sphere(model: BRDF, *, phi_l: float, ambient: float = 0.0, irradiance
     S = _check_size(size)
     C = model.n_channels or 1
     L = (math.sin(phi), 0.0, math.cos(phi))
-    out = np.zeros((S * S, C))
+    err, msg, ok = 0.0, "", True
+    if L_a > 0.0:  # the ambient image first; the direct term is added to it
+        # at least 1e-3 rad: the one pixel of a 1×1 image has θ_V = 0; the table needs a range
+        theta_max = max(math.acos(math.sqrt(max(1.0 - _max_r2(S), 0.0))), 1e-3)
+        table = ambient_table(model, theta_max=theta_max, tol=rho_tol)
+        out = L_a * _rho_image(table, S, C)
+        err, msg, ok = L_a * table.error, table.message, table.success
+    else:
+        out = np.zeros((S * S, C))
     if E > 0.0 and model.kernel is not None:
         P = np.ascontiguousarray(np.asarray(model.packed, dtype=np.float64))
         _direct(model.kernel, S, L[0], L[1], L[2], P, E, out)
@@ -305,24 +356,7 @@ def render_sphere(model: BRDF, *, phi_l: float, ambient: float = 0.0, irradiance
         if k:
             f = np.asarray(model.eval(wi[:k], wo[:k]), dtype=np.float64).reshape(k, C)
             _scatter(out, index[:k], E * cos_l[:k], np.ascontiguousarray(f))
-    c, mask = _disc(S)
-    err, msg, ok = 0.0, "", True
-    if L_a > 0.0:
-        # ρ(θ_V) is the same at (±x, ±y): evaluate one quadrant (the first h rows and
-        # columns, h = ⌈S/2⌉) and mirror it; N_z = √(1 − x² − y²) = cos θ_V
-        h = (S + 1) // 2
-        q = c[:h] ** 2
-        r2 = q[:, None] + q[None, :]
-        inside = r2 < 1.0
-        theta_v = np.arccos(np.sqrt(1.0 - r2[inside]))  # θ_V = angle between N and V = ẑ
-        # at least 1e-3 rad: the one pixel of a 1×1 image has θ_V = 0; the table needs a range
-        table = ambient_table(model, theta_max=max(float(np.max(theta_v)), 1e-3), tol=rho_tol)
-        quadrant = np.zeros((h, h, C))
-        quadrant[inside] = L_a * table(theta_v)
-        # mirror: columns (and then rows) 0 … h−1 followed by S − h of them reversed
-        top = np.concatenate([quadrant, quadrant[:, : S - h][:, ::-1]], axis=1)
-        out += np.concatenate([top, top[: S - h][::-1]], axis=0).reshape(S * S, C)
-        err, msg, ok = L_a * table.error, table.message, table.success
+    _, mask = _disc(S)
     return SphereRender(radiance=out.reshape(S, S, C), mask=mask, model=model.to_dict(),
                         phi_l=phi, ambient=L_a, irradiance=E, engine="direct",
                         ambient_error=err, ambient_message=msg, success=ok)

@@ -13,7 +13,7 @@ let inflight = false;
 
 function defaultState() {
   return { models: [{ spec: "modified-phong", params: {}, pump: null, times: 1, visible: true }],
-           theta_i: 30, phi_i: 0, phi_l: 30, ambient: 0, mode: "luminance", log: false,
+           theta_i: 30, phi_i: 0, phi_l: 30, ambient: 0, mode: "luminance", log: true,
            cosine: false, solo: null };
 }
 
