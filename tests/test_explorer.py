@@ -6,13 +6,12 @@ Reference values and their sources:
 - Phong's in-plane slice peaks at the mirror direction θ_o = +θ_i (R·V = 1 there, the
   definition of the lobe).
 - Rec. 709 luminance weights (0.2126, 0.7152, 0.0722) (ITU-R BT.709).
-- cook-torrance diverges at grazing incidence (Neumann et al. 1999, §3.2 as computed in
-  Table 2 by this project; the page must show what ``check`` says).
+- Ward's albedo diverges at grazing incidence like (cos θ_i)^−½ (Neumann et al. 1999, §3;
+  the page must show what ``check`` says).
 """
 
 from __future__ import annotations
 
-import base64
 import json
 import math
 import shutil
@@ -170,8 +169,9 @@ def _url(base, models, **extra):
 
 def _informative(png: bytes) -> bool:
     """A screenshot with content: more than a handful of distinct grey levels."""
-    from matplotlib.image import imread
     import io
+
+    from matplotlib.image import imread
 
     img = imread(io.BytesIO(png))
     return float(np.std(img[..., :3])) > 0.02
@@ -205,10 +205,10 @@ def test_page_loads_and_updates(browser, server, tmp_path):
 
 
 def test_page_shows_a_diverging_verdict_and_bad_input(browser, server):
-    page, errors = _open(browser, _url(server, [{"spec": "cook-torrance", "params": {}}]))
+    page, errors = _open(browser, _url(server, [{"spec": "ward", "params": {}}]))
     page.wait_for_function("document.getElementById('verdicts').textContent.includes('diverges')",
                            timeout=180_000)
-    assert "cook-torrance" in page.locator("#verdicts").text_content()
+    assert "ward" in page.locator("#verdicts").text_content()
     # a parameter out of bounds: a message in the page, the page still works
     m = page.locator("#model-list input[type=number]").first
     m.fill("-5")

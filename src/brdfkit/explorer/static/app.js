@@ -411,9 +411,10 @@ async function fetchVerdicts(req) {
       let energy = v.energy;
       if (v.energy === "diverges") energy += " at grazing, a ~ cos^-" + v.divergence_exponent;
       if (v.energy === "exceeds") energy += " 1 (×" + Number(v.max_scale).toPrecision(3) + " fixes it)";
-      line.innerHTML = "<b>" + v.model + "</b>: reciprocal " + (v.reciprocal ? "yes" : "no") +
+      line.innerHTML = "<b>" + v.model + "</b>: reciprocal " + ({ "reciprocal": "yes", "not reciprocal": "no" }[v.reciprocity] || v.reciprocity) +
         "; energy <span class='" + (v.energy === "conserves" ? "verdict-ok" : "verdict-bad") + "'>" +
-        energy + "</span>; max albedo " + Number(v.max_albedo).toPrecision(4) + " at " + v.theta_max_deg + "°";
+        energy + "</span>; max albedo " + Number(v.max_albedo).toPrecision(4) + " at " + v.theta_max_deg +
+        "° (albedo to " + v.tol + ")";
       line.className = "verdict";
       box.appendChild(line);
     });
