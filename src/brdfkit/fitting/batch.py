@@ -36,6 +36,8 @@ Public objects
 --------------
 - :class:`Job`, :func:`run_batch`, :class:`BatchReport`, :class:`BatchInterrupted`,
   :func:`read_rows`, :func:`write_rows`.
+- :func:`fit_row` — the job function of ``brdfkit fit … --out``: one fit, one row.
+- :func:`expand_targets` — ``merl:all``, ``rgl:all``, ``nielsen:all`` → material specs.
 """
 
 from __future__ import annotations
@@ -54,12 +56,15 @@ from brdfkit._io import check_output_path, write_atomic
 from brdfkit.errors import BrdfkitError
 
 __all__ = ["Job", "run_batch", "BatchReport", "BatchInterrupted", "read_rows", "write_rows",
-           "KEY_COLUMNS", "STATUS_OK", "STATUS_ERROR"]
+           "fit_row", "expand_targets", "KEY_COLUMNS", "STATUS_OK", "STATUS_ERROR",
+           "STATUS_NOT_CONVERGED"]
 
 #: Columns that identify a job's row (its key), first in every output file.
 KEY_COLUMNS = ("model", "target", "loss", "procedure")
 STATUS_OK = "ok"
 STATUS_ERROR = "error"
+#: A fit that ran but did not converge (its FitResult.success is False): kept, not retried.
+STATUS_NOT_CONVERGED = "not-converged"
 
 
 @dataclass(frozen=True)
@@ -206,7 +211,8 @@ def run_batch(jobs: Iterable[Job], *, out, run_job: Callable[[Job], dict], worke
         raise BrdfkitError(f"retries must be an integer from 0 to 10; got {retries!r}")
     unique = list({j.key: j for j in jobs}.values())
     rows = {_key_of(r): r for r in read_rows(path)}
-    finished = {k for k, r in rows.items() if r.get("status") == STATUS_OK}
+    finished = {k for k, r in rows.items()
+                if r.get("status") in (STATUS_OK, STATUS_NOT_CONVERGED)}
     todo = [j for j in unique if j.key not in finished]
     total, skipped = len(unique), len(unique) - len(todo)
     t0 = time.perf_counter()
@@ -291,3 +297,62 @@ def _run_dask(todo, run_job, scheduler, retries, record) -> None:
     finally:
         if own:
             client.close()
+
+
+# --------------------------------------------------------------------------- fits
+def expand_targets(specs: Iterable[str]) -> list[str]:
+    """Material specs with ``SOURCE:all`` expanded to every built-in material of SOURCE
+    (``merl:all@abc`` to their ABC fits); other specs unchanged, duplicates dropped."""
+    from brdfkit.data import material_names
+
+    out: list[str] = []
+    for spec in specs:
+        source, sep, rest = str(spec).partition(":")
+        name, at, rep = rest.partition("@")
+        if sep and name.strip().lower() == "all":
+            names = [s for s in material_names() if s.startswith(source.lower() + ":")]
+            if not names:
+                raise BrdfkitError(f"--to {spec}: no built-in source {source!r}; valid: "
+                                   "merl:all, rgl:all, nielsen:all")
+            out.extend(f"{s}@{rep}" if at else s for s in names)
+        else:
+            out.append(str(spec))
+    return list(dict.fromkeys(out))
+
+
+def fit_row(job: Job) -> dict:
+    """Fit ``job.model`` to ``job.target`` (:func:`brdfkit.fitting.fit`) and flatten the
+    result into one row: status (ok / not-converged), the loss value, the parameters (JSON,
+    ready for ``-p``), every metric (``metric_<name>``), the worst albedo relative error,
+    the evaluations and the seconds. ``job.options`` may hold ``pump``, ``times``,
+    ``seed`` and ``theta_max_deg``."""
+    import json
+    import math
+
+    import numpy as np
+
+    from brdfkit._specs import model as build_spec
+    from brdfkit.fitting.procedure import fit
+    from brdfkit.pumping import pump
+
+    opts = dict(job.options)
+    m = build_spec(job.model)
+    if opts.get("pump"):
+        m = pump(m, g=opts["pump"], times=int(opts.get("times", 1)))
+    target = build_spec(job.target)
+    theta_max = opts.get("theta_max_deg")
+    t0 = time.perf_counter()
+    r = fit(m, target, loss=job.loss, procedure=job.procedure, seed=int(opts.get("seed", 0)),
+            theta_max=None if theta_max is None else math.radians(float(theta_max)))
+    d = r.to_dict()
+    row = {"status": STATUS_OK if r.success else STATUS_NOT_CONVERGED,
+           "value": r.value, "params": json.dumps(d["params"], sort_keys=True)}
+    row.update({f"metric_{k}": v for k, v in sorted(r.metrics.items())})
+    rel = np.asarray(r.albedo_rel_error, dtype=np.float64)
+    row["albedo_max_rel_error"] = float(np.nanmax(np.abs(rel))) if rel.size else None
+    conv = r.convergence
+    row["evaluations"] = conv.get("evaluations")
+    row["at_bounds"] = json.dumps(conv.get("at_bounds", []))
+    row["seconds"] = round(time.perf_counter() - t0, 3)
+    row["message"] = r.message
+    return row
