@@ -292,6 +292,9 @@ def _normal_from_tan2(tan2: np.ndarray, u1: np.ndarray) -> np.ndarray:
 class Beckmann(HalfVectorDistribution):
     """Beckmann distribution of width α (NumPy side): D, sampling of D cos θ_h, its pdf."""
 
+    def __repr__(self) -> str:
+        return f"Beckmann(alpha={self.alpha!r})"
+
     def __init__(self, alpha: float):
         self.alpha = float(alpha)
 
@@ -315,6 +318,9 @@ class Beckmann(HalfVectorDistribution):
 
 class GGX(HalfVectorDistribution):
     """GGX / Trowbridge-Reitz distribution of width α (NumPy side)."""
+
+    def __repr__(self) -> str:
+        return f"GGX(alpha={self.alpha!r})"
 
     def __init__(self, alpha: float):
         self.alpha = float(alpha)

@@ -84,6 +84,11 @@ function paramControl(entry, p) {
   input.title = (p.doc || "") + " bounds " + p.bounds + (p.unit ? " (" + p.unit + ")" : "");
   input.addEventListener("change", () => {
     const text = String(input.value).trim();
+    if (p.clears && text !== "") {  // beta and the width it sets exclude each other
+      delete entry.params[p.clears];
+      const other = input.closest(".model").querySelector(`input[type=number][data-param="${p.clears}"], input[type=text][data-param="${p.clears}"]`);
+      if (other) other.value = "";
+    }
     if (text === "") delete entry.params[p.name];
     else if (p.kind === "choice") entry.params[p.name] = text;
     else if (text.includes(",")) entry.params[p.name] = text.split(",").map(Number);
@@ -91,10 +96,37 @@ function paramControl(entry, p) {
     update();
   });
   label.appendChild(input);
+  const slider = paramSlider(p, input);
+  if (slider) label.appendChild(slider);
   const hint = document.createElement("small");
   hint.textContent = " " + p.bounds;
   label.appendChild(hint);
   return label;
+}
+
+// A slider for a numeric parameter with finite bounds: linear over [lower, upper] when the
+// range is narrow, logarithmic for wide ones (exponents up to 1e6, k_s): the slider moves
+// the value live, the text box shows it (and still takes per-channel lists).
+function paramSlider(p, input) {
+  if (!(p.kind === "scalar" || p.kind === "colour") || p.lower === undefined ||
+      p.upper === undefined || !isFinite(p.lower) || !isFinite(p.upper)) return null;
+  const wide = p.upper > 100 * Math.max(1, Math.abs(p.lower));
+  const lo = wide ? Math.max(p.lower, 0.01) : p.lower, hi = p.upper;
+  const toT = v => wide ? (Math.log10(Math.max(v, lo)) - Math.log10(lo)) / (Math.log10(hi) - Math.log10(lo))
+                        : (v - lo) / (hi - lo);
+  const fromT = t => wide ? Math.pow(10, Math.log10(lo) + t * (Math.log10(hi) - Math.log10(lo)))
+                          : lo + t * (hi - lo);
+  const slider = document.createElement("input");
+  slider.type = "range"; slider.min = 0; slider.max = 1000; slider.step = 1;
+  slider.className = "param-slider"; slider.dataset.param = p.name;
+  const v0 = parseFloat(String(input.value).split(",")[0]);
+  slider.value = isFinite(v0) ? Math.round(1000 * Math.min(1, Math.max(0, toT(v0)))) : 500;
+  slider.addEventListener("input", () => {
+    const v = fromT(slider.value / 1000);
+    input.value = Number(v.toPrecision(4));
+    input.dispatchEvent(new Event("change"));
+  });
+  return slider;
 }
 
 function renderModelList() {
@@ -123,10 +155,13 @@ function renderModelList() {
     box.appendChild(head);
     const decl = declOf(entry.spec);
     if (decl) {
-      for (const p of decl.params) box.appendChild(paramControl(entry, p));
+      for (const p of decl.params) {
+        box.appendChild(paramControl(entry, decl.beta === p.name ? Object.assign({ clears: "beta" }, p) : p));
+      }
       if (decl.beta) {
         box.appendChild(paramControl(entry, { name: "beta", kind: "scalar", default: null,
-          bounds: "(0, 90) deg, sets " + decl.beta, unit: "deg", doc: "lobe half-angle" }));
+          lower: 0.5, upper: 89.5, bounds: "(0, 90) deg, sets " + decl.beta, unit: "deg",
+          doc: "lobe half-angle", clears: decl.beta }));
       }
     }
     const pumpLabel = document.createElement("label");
