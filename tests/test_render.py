@@ -289,3 +289,18 @@ def test_lewis_sphere_figures(monkeypatch):
     # one exposure: the brightest Φ_L = 0 sphere (column 0) is just white, none brighter
     assert max(np.max(imgs[i]) for i in range(0, 18, 3)) == 255
     assert any("Lewis (1993) Fig. 4" in t.get_text() for t in fig.texts)
+
+
+def test_light_azimuth_rotates_the_image():
+    """Identity: for an isotropic model, lighting from azimuth ψ = π/2 (image up) is the
+    ψ = 0 image turned a quarter turn counter-clockwise (the pixel grid maps onto itself)."""
+    import math
+
+    from brdfkit.render import render_sphere
+
+    m = brdfkit.model("modified-phong", n=50)
+    a = render_sphere(m, phi_l=0.6, size=32).radiance[..., 0]
+    b = render_sphere(m, phi_l=0.6, light_azimuth=math.pi / 2, size=32).radiance[..., 0]
+    np.testing.assert_allclose(b, np.rot90(a), atol=1e-12 * a.max())
+    with pytest.raises(brdfkit.ParameterError, match="light_azimuth"):
+        render_sphere(m, phi_l=0.6, light_azimuth=float("nan"), size=4)

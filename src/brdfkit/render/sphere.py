@@ -278,7 +278,8 @@ def _check_number(value, name: str, *, lower: float = 0.0) -> float:
     return v
 
 
-def render_sphere(model: BRDF, *, phi_l: float, ambient: float = 0.0, irradiance: float = 1.0,
+def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
+                  ambient: float = 0.0, irradiance: float = 1.0,
                   size: int = 256, engine: str = "direct",
                   rho_tol: float = RHO_TOL) -> SphereRender:
     """Render Lewis's sphere test configuration exactly.
@@ -290,6 +291,11 @@ def render_sphere(model: BRDF, *, phi_l: float, ambient: float = 0.0, irradiance
     phi_l : float, keyword-only
         Φ_L, the angle between the light and the view direction, radians in
         [0, π]: the light direction is L = (sin Φ_L, 0, cos Φ_L).
+    light_azimuth : float, keyword-only
+        ψ, the light's azimuth in the image plane, radians, counter-clockwise from +x
+        (image right); default 0 (Lewis's configuration). Generally
+        L = (sin Φ_L cos ψ, sin Φ_L sin ψ, cos Φ_L): ψ = π/4 lights from the upper right
+        (north-east), 5π/4 from the lower left (south-west; Nielsen et al. 2015, Fig. 1).
     ambient : float, keyword-only
         Uniform ambient radiance L_a ≥ 0 (default 0).
     irradiance : float, keyword-only
@@ -335,7 +341,11 @@ def render_sphere(model: BRDF, *, phi_l: float, ambient: float = 0.0, irradiance
     E = _check_number(irradiance, "irradiance")
     S = _check_size(size)
     C = model.n_channels or 1
-    L = (math.sin(phi), 0.0, math.cos(phi))
+    psi = float(light_azimuth)
+    if not math.isfinite(psi):
+        raise ParameterError(f"light_azimuth must be a finite angle in radians; got "
+                             f"{light_azimuth!r}")
+    L = (math.sin(phi) * math.cos(psi), math.sin(phi) * math.sin(psi), math.cos(phi))
     err, msg, ok = 0.0, "", True
     if L_a > 0.0:  # the ambient image first; the direct term is added to it
         # at least 1e-3 rad: the one pixel of a 1×1 image has θ_V = 0; the table needs a range
