@@ -1,0 +1,1 @@
+"""Rendering: the sphere test configuration and Monte-Carlo renders through Mitsuba 3."""
