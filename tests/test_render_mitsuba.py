@@ -240,7 +240,9 @@ def test_direction_mapping_non_reciprocal():
 
 @pytest.mark.parametrize("props,wi", [
     ({"model": "modified-phong", "rho_d": 0.3, "rho_s": 0.6, "n": 20.0}, [0.6, 0.0, 0.8]),
-    ({"model": "microfacet", "distribution": "ggx", "alpha": 0.3}, [0.48, 0.0, 0.877]),
+    # the parameters of the roughconductor comparison below (one compiled kernel for both)
+    ({"model": "microfacet", "distribution": "ggx", "alpha": 0.3, "eta": "0.2, 0.9, 1.1",
+      "k": "3.9, 2.4, 2.2"}, [0.48, 0.0, 0.877]),
     ({"model": "phong", "k_d": 0.1, "k_s": 0.3, "n": 10.0}, [0.0, 0.6, 0.8]),
 ])
 def test_chi2_mitsuba_harness(props, wi):

@@ -56,6 +56,18 @@ C on a ``wavelengths`` grid  error          error            interpolated at λ
   with C (all channels evaluated per path): keep grids to tens of points.
   :func:`spectral_model` builds such a model from parameter callables of λ.
 
+Cost, and a caveat
+------------------
+Measured (``benchmarks/bench_render_mitsuba.py``, 256² sphere, 16 spp, loaded
+2-core machine): the wavefront mode alone makes Mitsuba's own
+``roughconductor`` 4.5× slower than its default symbolic mode, and the bridge's
+``microfacet`` takes 12.5× the symbolic ``roughconductor`` (NumPy samplers and
+array conversions on top); the same GGX written in Dr.Jit operations and
+traced into Mitsuba's kernel takes 0.73×. While a bridge BSDF object is alive,
+Dr.Jit's symbolic calls trace it too and fail ("remains dirty"): render scenes
+with native BSDFs inside :func:`wavefront` as well, or drop the bridge objects
+(``del`` + ``gc.collect()``) first.
+
 Variants
 --------
 ``llvm_*`` variants need Debian's ``libllvm19`` (LLVM 15/16 load but abort on
@@ -279,8 +291,9 @@ def _mask(active, n: int) -> np.ndarray:
     return np.broadcast_to(np.array(active, dtype=bool).reshape(-1), (n,))
 
 
-def _width(dr, *xs) -> int:
-    return max(dr.width(x) for x in xs)
+def _width(dr, scalar: bool, *xs) -> int:
+    """Lanes of a call: 1 in scalar variants, else the widest argument (literals are 1)."""
+    return 1 if scalar else max(dr.width(x) for x in xs)
 
 
 def _bsdf_class(variant: str) -> type:
@@ -327,7 +340,7 @@ def _bsdf_class(variant: str) -> type:
             return self.colour(f, lambda: lanes.wavelengths[ok]) * light[:, 2:3]
 
         def _pairs(self, si, wo, active):
-            n = _width(dr, si, wo, active)
+            n = _width(dr, scalar, si.wi, si.wavelengths, wo, active)
             view = _vectors(si.wi, n)
             light = _vectors(wo, n)
             # one-sided: 0 below the horizon (brdfkit's convention, and Mitsuba's BSDFs')
@@ -358,7 +371,7 @@ def _bsdf_class(variant: str) -> type:
             return to_spectrum(out), to_float(p)
 
         def sample(self, ctx, si, sample1, sample2, active=True):
-            n = _width(dr, si, sample2, active)
+            n = _width(dr, scalar, si.wi, si.wavelengths, sample2, active)
             view = _vectors(si.wi, n)
             u = np.broadcast_to(np.array(sample2, dtype=np.float64).reshape(2, -1), (2, n)).T
             u = np.clip(u, 0.0, 1.0)  # float32 rounding of Mitsuba's samples (they are in [0, 1))
