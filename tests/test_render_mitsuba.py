@@ -356,6 +356,17 @@ def test_spectral_wavelength_grid_and_mono():
     si.wavelengths = mi.Spectrum(*wl[:, 0]) if n == 1 else mi.Spectrum(wl.astype(np.float32))
     got = np.array(bsdf.eval(mi.BSDFContext(), si, mi.Vector3f(0.0, 0.0, 1.0))).reshape(4, -1)
     np.testing.assert_allclose(got, wl[:, :got.shape[1]] / 1000.0 / math.pi, rtol=1e-5)
+    # an RGB model in a spectral variant: a grey RGB stays flat (the basis spectra are a
+    # partition of unity), and red reflects more at 680 nm than at 420 nm (and blue less)
+    ctx, up = mi.BSDFContext(), mi.Vector3f(0.0, 0.0, 1.0)
+    grey_rgb = mitsuba_bsdf(brdfkit.model("diffuse", rho_d=[0.5, 0.5, 0.5]))
+    np.testing.assert_allclose(np.array(grey_rgb.eval(ctx, si, up)), 0.5 / math.pi, rtol=1e-6)
+    red = np.array(mitsuba_bsdf(brdfkit.model("diffuse", rho_d=[0.9, 0.1, 0.1])).eval(
+        ctx, si, up)).reshape(4, -1)
+    blue = np.array(mitsuba_bsdf(brdfkit.model("diffuse", rho_d=[0.1, 0.1, 0.9])).eval(
+        ctx, si, up)).reshape(4, -1)
+    assert red[3, -1] > 3 * red[0, 0] and blue[0, 0] > 3 * blue[3, -1]
+    del grey_rgb
     with pytest.raises(brdfkit.errors.ParameterError, match="spectral variant"):
         mitsuba_bsdf(model, wavelengths=lam, variant="llvm_ad_rgb")
     mono = _variant("llvm_ad_mono")

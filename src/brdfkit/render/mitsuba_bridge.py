@@ -40,11 +40,15 @@ C on a ``wavelengths`` grid  error          error            interpolated at λ
 
 - *luminance*: Y = 0.212671 R + 0.715160 G + 0.072169 B (Rec. 709 / sRGB,
   Mitsuba's ``luminance``).
-- *sRGB upsampled*: per lane, f_r's (R, G, B) is turned into a smooth
-  spectrum with Mitsuba's sRGB model (Jakob & Hanika 2019,
-  ``srgb_model_fetch``/``srgb_model_eval``) after dividing by m = max(R, G,
-  B), and multiplied by m again (the model covers [0, 1] only; f_r is
-  unbounded).
+- *sRGB upsampled*: f(λ) = Σ_c f_c w_c(λ), with w_c = s_c/(s_R + s_G + s_B)
+  and s_c the smooth spectrum Mitsuba's sRGB model (Jakob & Hanika 2019,
+  ``srgb_model_fetch``/``srgb_model_eval``) gives the primary c. Linear in f
+  (so Monte-Carlo averages stay unbiased, and unbounded f_r is fine), a grey
+  f stays exactly flat; a coloured f develops under D65 to approximately its
+  RGB (pure primaries are outside the gamut of smooth spectra; measured: a
+  Lambertian (0.2, 0.5, 0.8) in a white furnace develops to (0.205, 0.500,
+  0.805) ± 0.005). Mitsuba's own
+  per-value upsampling (``srgb_model_fetch``) is scalar-only in Python.
 - *wavelength grid* (per-wavelength parameters, e.g. a metal's n, k): the
   model is built with C channels, channel c holding the parameters at
   ``wavelengths[c]`` (nm, increasing); per path the bridge evaluates all C
@@ -241,6 +245,7 @@ class _ColourMap:
         self.size = {"rgb": 3, "mono": 1, "spectral": 4}[self.kind]
         self.n_c = model.n_channels
         self.grid = grid
+        self._basis: np.ndarray | None = None  # RGB basis spectra, built on first use
         if grid is not None and self.kind != "spectral":
             raise ParameterError(
                 f"a model with per-wavelength channels (wavelengths given) needs a spectral "
@@ -265,19 +270,37 @@ class _ColourMap:
         return self._upsample(f2, lam(), m)
 
     def _upsample(self, rgb: np.ndarray, lam: np.ndarray, m: int) -> np.ndarray:
-        mi = self.mi
-        scale = rgb.max(axis=1)
-        safe = np.where(scale > 0.0, scale, 1.0)  # black stays black (0 · anything)
-        unit = np.ascontiguousarray((rgb / safe[:, None]).T, dtype=np.float32)
-        if mi.variant().startswith("scalar"):
-            coeff = mi.srgb_model_fetch(mi.Color3f(*unit[:, 0].tolist()))
-            s = np.array(mi.srgb_model_eval(coeff, mi.Spectrum(*lam[0].tolist())))[None, :]
+        """Σ_c f_c w_c(λ) per lane (module docstring), w on a 1-nm table."""
+        if self._basis is None:
+            self._basis = _primary_basis(self.mi)
+        w = np.stack([np.interp(lam, RGB_GRID, self._basis[c]) for c in range(3)], axis=-1)
+        return np.einsum("mc,mwc->mw", rgb, w)
+
+
+#: Wavelengths (nm) of the table of the RGB basis spectra: Mitsuba's visible range, 1 nm.
+RGB_GRID = np.arange(360.0, 831.0)
+
+
+def _primary_basis(mi) -> np.ndarray:
+    """w_c(λ) on RGB_GRID, shape (3, L): the sRGB-model spectra of the primaries (Jakob &
+    Hanika 2019, as Mitsuba fetches them) divided by their sum (a partition of unity)."""
+    spectra = []
+    scalar = mi.variant().startswith("scalar")
+    for e in np.eye(3):
+        coeff = mi.srgb_model_fetch(mi.ScalarColor3f(*e.tolist()))
+        if scalar:
+            vals = [float(mi.srgb_model_eval(coeff, mi.Spectrum(x, x, x, x))[0])
+                    for x in RGB_GRID.tolist()]
         else:
-            coeff = mi.srgb_model_fetch(mi.Color3f(unit))
-            spec = mi.srgb_model_eval(coeff, mi.Spectrum(
-                np.ascontiguousarray(lam.T, dtype=np.float32)))
-            s = np.array(spec, dtype=np.float64).reshape(4, -1).T
-        return s * scale[:, None]
+            import drjit as dr  # only the llvm variants get here (FALLBACK's keys)
+
+            lam = mi.Float(RGB_GRID.astype(np.float32))
+            out = mi.srgb_model_eval(dr.llvm.ad.Array3f(*[float(x) for x in coeff]),
+                                     mi.Spectrum(lam, lam, lam, lam))
+            vals = np.array(out, dtype=np.float64).reshape(4, -1)[0]
+        spectra.append(np.asarray(vals, dtype=np.float64))
+    s = np.stack(spectra)
+    return s / s.sum(axis=0)
 
 
 # ----------------------------------------------------------------------- the BSDF class
