@@ -62,12 +62,14 @@ C on a ``wavelengths`` grid  error          error            interpolated at λ
 
 Cost, and a caveat
 ------------------
-Measured (``benchmarks/bench_render_mitsuba.py``, 256² sphere, 16 spp, loaded
-2-core machine): the wavefront mode alone makes Mitsuba's own
-``roughconductor`` 4.5× slower than its default symbolic mode, and the bridge's
-``microfacet`` takes 12.5× the symbolic ``roughconductor`` (NumPy samplers and
-array conversions on top); the same GGX written in Dr.Jit operations and
-traced into Mitsuba's kernel takes 0.73×. While a bridge BSDF object is alive,
+Measured (``benchmarks/bench_render_mitsuba.py``, 256² sphere, 16 spp, two runs
+on a 2-core machine at load 4-6): the wavefront mode alone makes Mitsuba's own
+``roughconductor`` 2.9-4.5× slower than its default symbolic mode, and the
+bridge's ``microfacet`` (GGX) takes 6.4-12.5× the symbolic ``roughconductor``
+(brdfkit's NumPy samplers and the array conversions on top of the mode); the
+same GGX written in Dr.Jit operations and traced into Mitsuba's kernel takes
+0.64-0.73× (and gives the bridge's image to 1e-5 from the same seeds).
+While a bridge BSDF object is alive,
 Dr.Jit's symbolic calls trace it too and fail ("remains dirty"): render scenes
 with native BSDFs inside :func:`wavefront` as well, or drop the bridge objects
 (``del`` + ``gc.collect()``) first.
