@@ -16,6 +16,11 @@ Modules
   (:func:`ambient_table`), :func:`transposed`.
 - :mod:`brdfkit.render.image` — ``.npy``, ``.exr`` (own writer), ``.png``
   (sRGB with a stated exposure), atomic.
+- :mod:`brdfkit.render.mitsuba_bridge` — any brdfkit model as a Mitsuba 3 BSDF
+  (``{"type": "brdfkit", ...}`` in a scene dict, :func:`mitsuba_bsdf`); imported on
+  use (Mitsuba is an optional dependency).
+- :mod:`brdfkit.render.mitsuba_sphere` — the sphere test configuration by Monte Carlo
+  through Mitsuba (:func:`render_sphere_mitsuba`).
 
 References
 ----------
