@@ -267,7 +267,8 @@ def test_cli_render_sphere(tmp_path):
 
     with Image.open(png) as im:
         assert np.asarray(im).max() == 255  # phi0 exposure: the Φ_L = 0 peak is just white
-    for args, text in [(["--engine", "mitsuba"], "not available yet"),
+    for args, text in [(["--engine", "mitsuba", "--phi-l", "120"], "front hemisphere"),
+                       (["--engine", "mitsuba", "--spp", "0"], "--spp must be"),
                        (["--phi-l", "200"], "[0, 180]"),
                        (["--spp", "16"], "takes no samples"),
                        (["--exposure", "-1"], "--exposure"),

@@ -9,8 +9,8 @@ Render commands: ``brdfkit render sphere``
   radiance) or ``.png`` (sRGB with the stated exposure). Prints the path, or
   the render's metadata with ``--json``.
 
-Angles are in degrees on the command line. ``--engine mitsuba`` (Monte Carlo)
-is not available yet and says so.
+Angles are in degrees on the command line. ``--engine mitsuba --spp N`` renders the
+same configuration by Monte Carlo through Mitsuba 3 (brdfkit's model as the BSDF).
 """
 
 from __future__ import annotations
@@ -61,10 +61,13 @@ def render_group() -> None:
               help=f"Image side in pixels, 1 to {MAX_SIZE}.")
 @click.option("--engine", type=click.Choice(["direct", "mitsuba"]), default="direct",
               show_default=True,
-              help="direct: exact, deterministic. mitsuba (Monte Carlo): not available yet.")
+              help="direct: exact, deterministic. mitsuba: Monte Carlo through Mitsuba 3 "
+                   "with brdfkit's sampler (pixel-area averages; noise ~ 1/sqrt(spp)).")
 @click.option("--spp", type=int, default=None, metavar="N",
-              help="Samples per pixel of --engine mitsuba (not available yet); the direct "
-                   "engine takes none.")
+              help="Samples per pixel of --engine mitsuba (default 64); the direct engine "
+                   "takes none.")
+@click.option("--seed", type=int, default=0, show_default=True,
+              help="Sampler seed of --engine mitsuba (the render is deterministic given it).")
 @click.option("--exposure", default="phi0", show_default=True, metavar="K|phi0|peak",
               help="PNG only: display value = sRGB(min(1, K x radiance)). phi0: K = 1/peak "
                    "of the same sphere lit at phi_L = 0 (Lewis's rule: held constant across "
@@ -73,7 +76,7 @@ def render_group() -> None:
               help="Output file: .png (sRGB), .exr (linear, 32-bit float) or .npy (linear, "
                    "float64). Written atomically.")
 @click.option("--json", "as_json", is_flag=True, help="Print the render's metadata as JSON.")
-def sphere_cmd(model, param, pump, times, phi_l, ambient, irradiance, size, engine, spp,
+def sphere_cmd(model, param, pump, times, phi_l, ambient, irradiance, size, engine, spp, seed,
                exposure, out, as_json):
     """Render MODEL on Lewis's sphere test configuration (Lewis 1993, Fig. 2).
 
@@ -82,12 +85,14 @@ def sphere_cmd(model, param, pump, times, phi_l, ambient, irradiance, size, engi
     ambient radiance; radiance E f_r(L, V) max(N.L, 0) + L_a rho(V) at each
     pixel centre, 0 outside the disc (docs/rendering.md).
     """
-    if engine == "mitsuba":
-        raise BrdfkitError("--engine mitsuba (Monte Carlo through Mitsuba 3) is not available "
-                           "yet; use --engine direct (exact)")
-    if spp is not None:
+    if engine == "direct" and spp is not None:
         raise BrdfkitError(f"--spp {spp}: the direct engine is exact and takes no samples; "
-                           "drop --spp (it is for --engine mitsuba, not available yet)")
+                           "drop --spp (it is for --engine mitsuba)")
+    if spp is not None and not 1 <= spp <= 65536:
+        raise BrdfkitError(f"--spp must be an integer from 1 to 65536; got {spp}")
+    if engine == "mitsuba" and phi_l > 90.0:
+        raise BrdfkitError(f"--phi-l {phi_l}: the mitsuba engine lights from the front "
+                           "hemisphere, 0 to 90 degrees; use --engine direct beyond")
     if not 0.0 <= phi_l <= 180.0:  # also refuses NaN
         raise BrdfkitError(f"--phi-l must lie in [0, 180] degrees; got {phi_l}")
     for name, v in (("--ambient", ambient), ("--irradiance", irradiance)):
@@ -99,7 +104,7 @@ def sphere_cmd(model, param, pump, times, phi_l, ambient, irradiance, size, engi
     _io.check_output_path(out, option="--out", suffixes=SUFFIXES)  # before any work
     m = build_model(model, param, pump, times)
     result = render_sphere(m, phi_l=math.radians(phi_l), ambient=ambient,
-                           irradiance=irradiance, size=size)
+                           irradiance=irradiance, size=size, engine=engine, spp=spp, seed=seed)
     k, how = None, ""
     if out.lower().endswith(".png"):
         if rule == "phi0":

@@ -59,7 +59,9 @@ __all__ = ["SphereRender", "render_sphere", "sphere_geometry", "exposure_phi0", 
 #: Largest image side: 8192² pixels of 3 channels are 1.6 GB of float64 radiance.
 MAX_SIZE = 8192
 #: Engines of :func:`render_sphere`; ``mitsuba`` (Monte Carlo) is planned (issue 11 §3).
-ENGINES = ("direct",)
+ENGINES = ("direct", "mitsuba")
+#: Default samples per pixel of the Monte-Carlo engine.
+DEFAULT_SPP = 64
 
 
 @dataclass(frozen=True)
@@ -81,7 +83,10 @@ class SphereRender:
     ambient, irradiance : float
         L_a and E.
     engine : str
-        ``"direct"`` (deterministic; no samples, no variance).
+        ``"direct"`` (deterministic; no samples, no variance) or ``"mitsuba"``
+        (Monte Carlo: pixel-area averages, noise ∝ 1/√spp).
+    spp, seed : int or None
+        The Monte-Carlo engine's samples per pixel and seed (None for direct).
     ambient_error : float
         Absolute error estimate of the ambient term L_a·ρ(V) at any pixel
         (0 when L_a = 0); the direct term is exact to rounding.
@@ -101,6 +106,8 @@ class SphereRender:
     ambient_error: float = 0.0
     ambient_message: str = ""
     success: bool = True
+    spp: int | None = None
+    seed: int | None = None
 
     @property
     def size(self) -> int:
@@ -117,7 +124,8 @@ class SphereRender:
                 "ambient": self.ambient, "irradiance": self.irradiance, "size": self.size,
                 "channels": int(self.radiance.shape[2]), "engine": self.engine,
                 "ambient_error": self.ambient_error, "ambient_message": self.ambient_message,
-                "success": self.success, "peak": self.peak}
+                "success": self.success, "peak": self.peak, "spp": self.spp,
+                "seed": self.seed}
 
 
 @numba.njit(cache=True, inline="always")
@@ -280,7 +288,8 @@ def _check_number(value, name: str, *, lower: float = 0.0) -> float:
 
 def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
                   ambient: float = 0.0, irradiance: float = 1.0,
-                  size: int = 256, engine: str = "direct",
+                  size: int = 256, engine: str = "direct", spp: int | None = None,
+                  seed: int = 0, variant: str = "llvm_ad_rgb",
                   rho_tol: float = RHO_TOL) -> SphereRender:
     """Render Lewis's sphere test configuration exactly.
 
@@ -302,9 +311,14 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
         E ≥ 0, the light's irradiance on a surface facing it (default 1).
     size : int, keyword-only
         Image side S in pixels, 1 … :data:`MAX_SIZE` (default 256).
-    engine : {"direct"}, keyword-only
-        ``direct``: deterministic, exact at pixel centres. (``mitsuba``,
-        Monte Carlo, is not available yet.)
+    engine : {"direct", "mitsuba"}, keyword-only
+        ``direct``: deterministic, exact at pixel centres. ``mitsuba``: Monte
+        Carlo through Mitsuba 3 with brdfkit's own sampler
+        (:func:`brdfkit.render.mitsuba_sphere.render_sphere_mitsuba`): pixel-area
+        averages that agree with ``direct`` within noise away from the rim.
+    spp, seed, variant : keyword-only
+        Samples per pixel (default :data:`DEFAULT_SPP`), seed and Mitsuba variant of
+        the ``mitsuba`` engine; ``direct`` takes no samples (``spp`` must be None).
     rho_tol : float, keyword-only
         Accuracy goal of ρ(V) when L_a > 0 (see
         :func:`brdfkit.render.ambient.ambient_table`; cached per model).
@@ -328,9 +342,6 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
                 else "")
         raise BrdfkitError(f"render_sphere: model must be a brdfkit model (BRDF); got "
                            f"{type(model).__name__}{hint}")
-    if engine == "mitsuba":
-        raise BrdfkitError("engine 'mitsuba' (Monte Carlo through Mitsuba 3) is not available "
-                           "yet; use engine 'direct' (exact)")
     if engine not in ENGINES:
         raise ParameterError(f"engine must be one of {', '.join(ENGINES)}; got {engine!r}")
     phi = _check_number(phi_l, "phi_l")
@@ -341,6 +352,23 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
     E = _check_number(irradiance, "irradiance")
     S = _check_size(size)
     C = model.n_channels or 1
+    if engine == "mitsuba":
+        from brdfkit.render.mitsuba_sphere import render_sphere_mitsuba
+
+        if light_azimuth != 0.0:
+            raise ParameterError("light_azimuth is not supported by the mitsuba engine; "
+                                 "use engine='direct'")
+        n = DEFAULT_SPP if spp is None else spp
+        rad = render_sphere_mitsuba(model, phi_l=phi, ambient=L_a, irradiance=E, size=S,
+                                    spp=n, seed=seed, variant=variant)
+        _, mask = _disc(S)
+        return SphereRender(radiance=np.asarray(rad, dtype=np.float64), mask=mask,
+                            model=model.to_dict(), phi_l=phi, ambient=L_a, irradiance=E,
+                            engine="mitsuba", spp=int(n), seed=int(seed),
+                            ambient_message="Monte Carlo: pixel-area averages, noise ~ 1/sqrt(spp)")
+    if spp is not None:
+        raise ParameterError(f"spp={spp!r}: the direct engine is exact and takes no samples; "
+                             "drop spp or use engine='mitsuba'")
     psi = float(light_azimuth)
     if not math.isfinite(psi):
         raise ParameterError(f"light_azimuth must be a finite angle in radians; got "
