@@ -32,7 +32,7 @@ from brdfkit.cli import _progress, main
 from brdfkit.cli._common import PUMP_MAX_TIMES, build_model, parse_direction
 from brdfkit.cli.analysis import MAX_ANGLES, parse_theta
 from brdfkit.errors import BrdfkitError
-from brdfkit.figures import FIGURES, check_output_path, save_atomic
+from brdfkit.figures import FIGURES, MODEL_FIGURES, check_output_path, save_atomic
 
 SRC = pathlib.Path(brdfkit.__file__).resolve().parent
 
@@ -346,7 +346,7 @@ def test_sigterm_handler_is_restored_after_a_command():
 def test_figure_list_needs_no_out():
     r = run("figure", "list")
     assert r.exit_code == 0, r.stderr
-    assert r.stdout.split() == sorted(FIGURES)
+    assert r.stdout.split() == sorted([*FIGURES, *MODEL_FIGURES])
 
 
 def test_figure_list_refuses_out_and_building_needs_out():
@@ -411,7 +411,7 @@ def _imports(path: pathlib.Path) -> set[str]:
 
 
 def test_figure_modules_import_downward_only():
-    for name in ("lewis", "lewis_spheres", "neumann", "pumping"):
+    for name in ("lewis", "lewis_spheres", "neumann", "pumping", "models"):
         imported = _imports(SRC / "figures" / f"{name}.py")
         assert not {m for m in imported if m.startswith("brdfkit.figures")}, (name, imported)
     assert not {m for m in _imports(SRC / "figures" / "_save.py")
@@ -429,7 +429,7 @@ def test_cli_command_modules_do_not_import_the_cli_package():
         bad = {m for m in _imports(path) if m in ("brdfkit.cli", "brdfkit.cli.main")}
         assert not bad, (path.name, bad)
     assert set(main.commands) == {"models", "eval", "albedo", "check", "table2", "figure",
-                                  "render"}
+                                  "render", "materials", "export", "explore"}
     assert set(main.commands["render"].commands) == {"sphere"}
 
 
