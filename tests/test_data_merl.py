@@ -177,6 +177,97 @@ def test_indices_agree_with_the_reference_formulas(rng):
     np.testing.assert_array_equal(merl_indices(edge_i, edge_o), reference_index(edge_i, edge_o))
 
 
+def _reference_coords(wi, wo):
+    """The reference's continuous index coordinates (u_θh, u_θd, u_φd) before the floor,
+    and sin θ_d = |(d_x, d_y)|."""
+    h = wi + wo
+    h = h / np.linalg.norm(h, axis=-1, keepdims=True)
+    theta_h = np.arccos(np.clip(h[..., 2], -1, 1))
+    phi_h = np.arctan2(h[..., 1], h[..., 0])
+    d = _rotate(_rotate(wi, np.array([0.0, 0.0, 1.0]), -phi_h), np.array([0.0, 1.0, 0.0]),
+                -theta_h)
+    pd = np.arctan2(d[..., 1], d[..., 0])
+    pd = np.where(pd < 0, pd + np.pi, pd)
+    return (np.sqrt(theta_h / (np.pi / 2) * 8100), np.arccos(np.clip(d[..., 2], -1, 1))
+            / (np.pi / 2) * 90, pd / np.pi * 180, np.hypot(d[..., 0], d[..., 1]))
+
+
+def _adversarial_pairs(rng, n):
+    """Pairs on or within rounding of bin boundaries: θ_h = (k/90)²·π/2, θ_d = k·π/180,
+    φ_d = k·π/180 (k random, all three axes at once), each shifted by 0 or ±1e-16 ...
+    ±1e-10 rad, at φ_h = 0, a multiple of π/2 or random; then pairs in the plane of
+    incidence (d_y = ±0, φ_d = 0 or π), wi = wo (d = n) and normal incidence."""
+    def shift(size):
+        return rng.choice([0.0, 1e-16, 3e-16, 1e-15, 1e-13, 1e-10], size) * rng.choice(
+            [-1.0, 1.0], size)
+
+    th = (rng.integers(0, 91, n) / 90) ** 2 * (np.pi / 2) + np.abs(shift(n))
+    td = rng.integers(0, 91, n) * (np.pi / 180) + np.abs(shift(n))
+    pd = rng.integers(0, 181, n) * (np.pi / 180) + shift(n)
+    wi, wo = half_diff_to_directions(th, td, pd)
+    phi_h = np.where(rng.random(n) < 0.5, rng.integers(0, 4, n) * (np.pi / 2),
+                     rng.random(n) * 2 * np.pi)
+    c, s = np.cos(phi_h)[:, None], np.sin(phi_h)[:, None]
+
+    def rot(w):
+        return np.stack([w[:, 0] * c[:, 0] - w[:, 1] * s[:, 0],
+                         w[:, 0] * s[:, 0] + w[:, 1] * c[:, 0], w[:, 2]], axis=-1)
+
+    m = n // 10
+    ti, to = rng.random(m) * (np.pi / 2), rng.random(m) * (np.pi / 2)
+    po = np.where(rng.random(m) < 0.5, 0.0, np.pi)
+    plane_i = np.stack([np.sin(ti), np.zeros(m), np.cos(ti)], -1)
+    plane_o = np.stack([np.sin(to) * np.cos(po), np.zeros(m), np.cos(to)], -1)
+    same = _random_pairs(rng, m)[0]
+    normal = np.tile([0.0, 0.0, 1.0], (m, 1))
+    return (np.concatenate([rot(wi), plane_i, same, normal, same]),
+            np.concatenate([rot(wo), plane_o, same, same, normal]))
+
+
+def test_fast_index_is_the_formula_index_on_1e7_pairs(rng):
+    """The lookup's index without acos/atan2 (exact step tables + boundary side tests)
+    against the acos/atan2 formulas, bit for bit: 1e7 random pairs, then 1e6 pairs on and
+    within rounding of every kind of bin boundary, where a wrong table or margin shows."""
+    for _ in range(5):
+        # uniform on the hemisphere: normalised Gaussian triples, z made positive (faster
+        # than _random_pairs' trigonometry for this many pairs)
+        g = rng.standard_normal((2, 2_000_000, 3))
+        g[..., 2] = np.abs(g[..., 2])
+        g /= np.sqrt(np.einsum("...k,...k->...", g, g))[..., None]
+        wi, wo = g
+        np.testing.assert_array_equal(merl_indices(wi, wo),
+                                      merl_indices(wi, wo, method="formula"))
+    wi, wo = _adversarial_pairs(rng, 720_000)
+    assert wi.shape[0] >= 1_000_000
+    fast = merl_indices(wi, wo)
+    np.testing.assert_array_equal(fast, merl_indices(wi, wo, method="formula"))
+    # and against the reference written above (Rodrigues rotations): an axis's index may
+    # differ only where the reference's coordinate is within rounding of a boundary, as
+    # its formula's conditioning gives it. d carries an absolute error δ ≈ 1e-15 +
+    # 1e-15/sin θ_h (acos near 1: h_z rounded by ~2 ulp moves θ_h by ~4e-16/sin θ_h rad,
+    # which rotates d); θ_h and θ_d then move by ~δ rad (×57.3 bins/rad), φ_d by δ/sin θ_d
+    # (undefined at θ_d = 0, wi = wo; sin θ_d from |(d_x, d_y)|, as acos near 1 would
+    # overstate it). Plus 1e-9 bins for the rest. wi = −wo (h = 0: the reference divides
+    # by 0) is left out.
+    sub = slice(0, 300_000)
+    with np.errstate(divide="ignore", invalid="ignore"):  # h = 0: NaN, left out below
+        ref = reference_index(wi[sub], wo[sub])
+        differ = fast[sub] != ref
+        uh, ud, up, sd = _reference_coords(wi[sub][differ], wo[sub][differ])
+    a, b = fast[sub][differ], ref[differ]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        delta = 1e-15 + 1e-15 / np.sin((uh / 90) ** 2 * (np.pi / 2))
+        tol_theta = 1e-9 + 57.3 * delta
+        tol_phi = 1e-9 + 57.3 * delta / sd
+    defined = np.isfinite(uh)
+    for u, axis, tol in ((uh, a // 16200 != b // 16200, tol_theta),
+                         (ud, (a // 180) % 90 != (b // 180) % 90, tol_theta),
+                         (up, a % 180 != b % 180, tol_phi)):
+        axis &= defined
+        assert np.all(np.abs(u - np.round(u))[axis] < tol[axis])
+    assert differ.mean() < 0.2  # the set is adversarial, but most pairs still agree
+
+
 def test_nearest_eval_is_the_reference_lookup(merl_file, rng):
     t = read_binary(merl_file)
     m = MeasuredBRDF(t)
