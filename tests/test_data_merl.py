@@ -129,9 +129,14 @@ def _write_bytes(path, data: bytes):
     (lambda b: b"", "header"),
     (lambda b: np.array([90, 90, 360], "<i4").tobytes() + b[12:], "(90, 90, 360)"),
     (lambda b: np.array([180, 90, 90], "<i4").tobytes() + b[12:], "(180, 90, 90)"),
-    (lambda b: b[:-8], "truncated"),
+    (lambda b: np.array([90, 45, 180], "<i4").tobytes() + b[12:], "expected dimensions (90, 90, 180); found (90, 45, 180)"),
+    (lambda b: np.array([90, 90, 180], ">i4").tobytes() + b[12:], "found (1509949440, 1509949440, -1275068416)"),  # big-endian
+    (lambda b: b[:-8], f"expected {FILE_BYTES} bytes"),
+    (lambda b: b[:-8], f"found {FILE_BYTES - 8}"),
     (lambda b: b + b"\0" * 8, "too long"),
+    (lambda b: b + b"\0" * 8, f"found {FILE_BYTES + 8}"),
     (lambda b: b[:100] + np.array([np.nan]).tobytes() + b[108:], "NaN"),
+    (lambda b: b[:100] + np.array([-np.inf]).tobytes() + b[108:], "1 NaN/inf"),
     (lambda b: b[:12] + np.full(3 * N_BINS, -1.0).tobytes(), "every entry"),
 ])
 def test_malformed_files_name_file_and_field(tmp_path, merl_file, mutate, needle):
@@ -149,21 +154,39 @@ def test_not_a_file(tmp_path):
         read_binary(tmp_path)
 
 
-def test_fuzz_truncations_and_header_corruptions(tmp_path, merl_file):
-    # never crash (only DataFileError), never hang (each read well under a second)
+def test_fuzz_truncations_and_header_corruptions(tmp_path, merl_file, raw_table):
+    """Seeded fuzz: random truncations, random header bytes, random bit flips of the
+    header, random trailing bytes. Each read either raises DataFileError naming the file
+    or — only when the bytes still are a valid file — returns the original table; none
+    crashes with another exception or hangs."""
     rng = np.random.default_rng(11)
     good = merl_file.read_bytes()
-    for k in range(40):
-        b = bytearray(good[: int(rng.integers(0, len(good) + 1))] if k % 2 else good)
-        if k % 3 == 0 and len(b) >= 12:
-            b[int(rng.integers(0, 12))] = int(rng.integers(0, 256))
-        p = _write_bytes(tmp_path / f"f{k}.binary", bytes(b))
+    for k in range(28):  # 35 MB files: each full-size case costs ~0.2 s to write
+        kind = k % 4
+        if kind == 0:  # truncated: mostly within the header or early data, some late
+            cut = int(rng.integers(0, 200)) if k % 8 == 0 else int(rng.integers(0, len(good)))
+            b = good[:cut]
+        elif kind == 1:  # random header bytes
+            b = rng.integers(0, 256, 12, dtype=np.uint8).tobytes() + good[12:]
+        elif kind == 2:  # one to three bit flips in the header
+            h = bytearray(good[:12])
+            for _ in range(int(rng.integers(1, 4))):
+                h[int(rng.integers(0, 12))] ^= 1 << int(rng.integers(0, 8))
+            b = bytes(h) + good[12:]
+        else:  # trailing garbage
+            b = good + rng.integers(0, 256, int(rng.integers(1, 64)), dtype=np.uint8).tobytes()
+        p = _write_bytes(tmp_path / f"f{k}.binary", b)
+        valid = b[:12] == good[:12] and len(b) == len(good)
         t0 = time.perf_counter()
         try:
-            read_binary(p)
-        except DataFileError:
-            pass
+            t = read_binary(p)
+        except DataFileError as exc:
+            assert str(p) in str(exc) and not valid
+        else:
+            assert valid
+            np.testing.assert_array_equal(t.raw, raw_table)
         assert time.perf_counter() - t0 < 5.0
+        p.unlink()
 
 
 # ----------------------------------------------------------------- lookup
