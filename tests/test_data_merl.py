@@ -129,8 +129,10 @@ def _write_bytes(path, data: bytes):
     (lambda b: b"", "header"),
     (lambda b: np.array([90, 90, 360], "<i4").tobytes() + b[12:], "(90, 90, 360)"),
     (lambda b: np.array([180, 90, 90], "<i4").tobytes() + b[12:], "(180, 90, 90)"),
-    (lambda b: np.array([90, 45, 180], "<i4").tobytes() + b[12:], "expected dimensions (90, 90, 180); found (90, 45, 180)"),
-    (lambda b: np.array([90, 90, 180], ">i4").tobytes() + b[12:], "found (1509949440, 1509949440, -1275068416)"),  # big-endian
+    (lambda b: np.array([90, 45, 180], "<i4").tobytes() + b[12:],
+     "expected dimensions (90, 90, 180); found (90, 45, 180)"),
+    (lambda b: np.array([90, 90, 180], ">i4").tobytes() + b[12:],  # big-endian
+     "found (1509949440, 1509949440, -1275068416)"),
     (lambda b: b[:-8], f"expected {FILE_BYTES} bytes"),
     (lambda b: b[:-8], f"found {FILE_BYTES - 8}"),
     (lambda b: b + b"\0" * 8, "too long"),
@@ -288,7 +290,6 @@ def test_fast_index_is_the_formula_index_on_1e7_pairs(rng):
                          (up, a % 180 != b % 180, tol_phi)):
         axis &= defined
         assert np.all(np.abs(u - np.round(u))[axis] < tol[axis])
-    assert differ.mean() < 0.2  # the set is adversarial, but most pairs still agree
 
 
 def test_nearest_eval_is_the_reference_lookup(merl_file, rng):

@@ -203,12 +203,14 @@ def _half_diff_vec(ix, iy, iz, ox, oy, oz):
     n = math.sqrt(hx * hx + hy * hy + hz * hz)
     if n <= 0.0:
         return 1.0, 1.0, 0.0, 0.0  # wi = −wo (only below the horizon): θ_h = 0, θ_d = π/2
-    hx /= n
-    hy /= n
-    hz /= n
+    inv = 1.0 / n  # one division, three products (not three divisions)
+    hx *= inv
+    hy *= inv
+    hz *= inv
     rho = math.sqrt(hx * hx + hy * hy)
     if rho > 0.0:
-        cp, sp = hx / rho, hy / rho  # cos φ_h, sin φ_h
+        inv = 1.0 / rho
+        cp, sp = hx * inv, hy * inv  # cos φ_h, sin φ_h
     else:
         cp, sp = 1.0, 0.0  # h = N: atan2(0, 0) = 0
     # rotate wi about the normal by −φ_h, then about the binormal (y) by −θ_h
@@ -329,29 +331,37 @@ def _fast_index(hz, dx, dy, dz, Q):
         kh -= 1
     while hz < Q[_Q_TH + kh + 1]:  # T_h[90] = −inf stops it
         kh += 1
-    # θ_d: the same with T_d (d_z ≤ 0: θ_d ≥ π/2, the last bin)
-    kd = min(int(_acos_guess(min(dz, 1.0)) * _TD_SCALE), 89) if dz > 0.0 else 89
+    # θ_d: the same with T_d (d_z ≤ 0: θ_d ≥ π/2, guessed as the last bin)
+    kd = min(int(_acos_guess(min(max(dz, 0.0), 1.0)) * _TD_SCALE), 89)
     while dz >= Q[_Q_TD + kd]:
         kd -= 1
     while dz < Q[_Q_TD + kd + 1]:
         kd += 1
-    # φ_d: fold (d_x, d_y) to the upper half plane (the formula's +π for φ_d < 0)
-    if dy < 0.0:
-        x, y = -dx, -dy
-    else:
-        x, y = dx, dy
+    return _fast_phi_index(dx, dy, Q) + 180 * kd + 16200 * kh
+
+
+@numba.njit(cache=True, inline="always")
+def _fast_phi_index(dx, dy, Q):
+    """The φ_d bin of (d_x, d_y): a guess, then the side tests (fallback: atan2). Written
+    with selects rather than branches where the data decide (a random φ_d mispredicts
+    half of such branches; measured 66 → 40 ns per pair)."""
+    # fold (d_x, d_y) to the upper half plane (the formula's +π for φ_d < 0); d_y = −0 is
+    # folded too, which puts (x, y) on the boundary φ = 0 or π: the side test sends it to
+    # atan2, which decides as the formula does
+    sgn = math.copysign(1.0, dy)
+    x = dx * sgn
+    y = abs(dy)
     ax = abs(x)
-    scale = ax + y  # |d_x| + |d_y| (y ≥ 0 or −0)
-    if not scale > _PHI_TINY:  # also NaN
-        return _phi_d_index(math.atan2(dy, dx)) + 180 * kd + 16200 * kh
-    if y <= ax:
-        phi = _atan_guess(y / ax)
-    else:
-        phi = 0.5 * math.pi - _atan_guess(ax / y)
-    if x < 0.0:
-        phi = math.pi - phi
-    kp = min(max(int(phi * _PD_SCALE), 0), 179)
+    scale = ax + y  # |d_x| + |d_y|
+    a = _atan_guess(min(ax, y) / max(ax, y))  # the angle to the nearer axis (NaN for 0/0)
+    phi = a + (1.0 if y > ax else 0.0) * (0.5 * math.pi - 2.0 * a)  # in [0, π/2]
+    phi = phi + (1.0 if x < 0.0 else 0.0) * (math.pi - 2.0 * phi)  # in [0, π]
+    kp = min(max(int(phi * _PD_SCALE), 0), 179) if phi == phi else 0
     m = _PHI_MARGIN * scale
+    if _phi_side(Q, kp, x, y) > m and _phi_side(Q, kp + 1, x, y) < -m:
+        return kp  # inside bin kp by more than the margin on both sides: nearly always
+    if not scale > _PHI_TINY:  # also NaN
+        return _phi_d_index(math.atan2(dy, dx))
     while kp > 0 and _phi_side(Q, kp, x, y) < -m:
         kp -= 1
     while kp < 179 and _phi_side(Q, kp + 1, x, y) > m:
@@ -359,7 +369,7 @@ def _fast_index(hz, dx, dy, dz, Q):
     # inside bin kp by more than the margin on both sides, or atan2 decides
     if not (abs(_phi_side(Q, kp, x, y)) > m and abs(_phi_side(Q, kp + 1, x, y)) > m):
         kp = _phi_d_index(math.atan2(dy, dx))
-    return kp + 180 * kd + 16200 * kh
+    return kp
 
 
 #: Floats checked on each side of every step of the θ_h and θ_d indices (_index_tables).
