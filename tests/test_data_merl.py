@@ -265,7 +265,18 @@ def test_fast_index_is_the_formula_index_on_1e7_pairs(rng):
     wi, wo = _adversarial_pairs(rng, 720_000)
     assert wi.shape[0] >= 1_000_000
     fast = merl_indices(wi, wo)
-    np.testing.assert_array_equal(fast, merl_indices(wi, wo, method="formula"))
+    formula = merl_indices(wi, wo, method="formula")
+    np.testing.assert_array_equal(fast, formula)
+    # tables switched off (as where acos would not step cleanly): the formulas, unchanged
+    from brdfkit.data import _merl_index as mi
+
+    Q = mi._index_tables().copy()
+    Q[mi._Q_OK] = 0.0
+    Q.flags.writeable = False  # the type the compiled loop has already seen
+    out = np.empty(wi.shape[0], dtype=np.int64)
+    mi._indices(wi, wo, Q, out)
+    np.testing.assert_array_equal(out, formula)
+    assert mi._index_tables()[mi._Q_OK] == 1.0  # this machine's acos steps cleanly
     # and against the reference written above (Rodrigues rotations): an axis's index may
     # differ only where the reference's coordinate is within rounding of a boundary, as
     # its formula's conditioning gives it. d carries an absolute error δ ≈ 1e-15 +
