@@ -129,9 +129,16 @@ def _write_bytes(path, data: bytes):
     (lambda b: b"", "header"),
     (lambda b: np.array([90, 90, 360], "<i4").tobytes() + b[12:], "(90, 90, 360)"),
     (lambda b: np.array([180, 90, 90], "<i4").tobytes() + b[12:], "(180, 90, 90)"),
-    (lambda b: b[:-8], "truncated"),
+    (lambda b: np.array([90, 45, 180], "<i4").tobytes() + b[12:],
+     "expected dimensions (90, 90, 180); found (90, 45, 180)"),
+    (lambda b: np.array([90, 90, 180], ">i4").tobytes() + b[12:],  # big-endian
+     "found (1509949440, 1509949440, -1275068416)"),
+    (lambda b: b[:-8], f"expected {FILE_BYTES} bytes"),
+    (lambda b: b[:-8], f"found {FILE_BYTES - 8}"),
     (lambda b: b + b"\0" * 8, "too long"),
+    (lambda b: b + b"\0" * 8, f"found {FILE_BYTES + 8}"),
     (lambda b: b[:100] + np.array([np.nan]).tobytes() + b[108:], "NaN"),
+    (lambda b: b[:100] + np.array([-np.inf]).tobytes() + b[108:], "1 NaN/inf"),
     (lambda b: b[:12] + np.full(3 * N_BINS, -1.0).tobytes(), "every entry"),
 ])
 def test_malformed_files_name_file_and_field(tmp_path, merl_file, mutate, needle):
@@ -149,21 +156,39 @@ def test_not_a_file(tmp_path):
         read_binary(tmp_path)
 
 
-def test_fuzz_truncations_and_header_corruptions(tmp_path, merl_file):
-    # never crash (only DataFileError), never hang (each read well under a second)
+def test_fuzz_truncations_and_header_corruptions(tmp_path, merl_file, raw_table):
+    """Seeded fuzz: random truncations, random header bytes, random bit flips of the
+    header, random trailing bytes. Each read either raises DataFileError naming the file
+    or — only when the bytes still are a valid file — returns the original table; none
+    crashes with another exception or hangs."""
     rng = np.random.default_rng(11)
     good = merl_file.read_bytes()
-    for k in range(40):
-        b = bytearray(good[: int(rng.integers(0, len(good) + 1))] if k % 2 else good)
-        if k % 3 == 0 and len(b) >= 12:
-            b[int(rng.integers(0, 12))] = int(rng.integers(0, 256))
-        p = _write_bytes(tmp_path / f"f{k}.binary", bytes(b))
+    for k in range(28):  # 35 MB files: each full-size case costs ~0.2 s to write
+        kind = k % 4
+        if kind == 0:  # truncated: mostly within the header or early data, some late
+            cut = int(rng.integers(0, 200)) if k % 8 == 0 else int(rng.integers(0, len(good)))
+            b = good[:cut]
+        elif kind == 1:  # random header bytes
+            b = rng.integers(0, 256, 12, dtype=np.uint8).tobytes() + good[12:]
+        elif kind == 2:  # one to three bit flips in the header
+            h = bytearray(good[:12])
+            for _ in range(int(rng.integers(1, 4))):
+                h[int(rng.integers(0, 12))] ^= 1 << int(rng.integers(0, 8))
+            b = bytes(h) + good[12:]
+        else:  # trailing garbage
+            b = good + rng.integers(0, 256, int(rng.integers(1, 64)), dtype=np.uint8).tobytes()
+        p = _write_bytes(tmp_path / f"f{k}.binary", b)
+        valid = b[:12] == good[:12] and len(b) == len(good)
         t0 = time.perf_counter()
         try:
-            read_binary(p)
-        except DataFileError:
-            pass
+            t = read_binary(p)
+        except DataFileError as exc:
+            assert str(p) in str(exc) and not valid
+        else:
+            assert valid
+            np.testing.assert_array_equal(t.raw, raw_table)
         assert time.perf_counter() - t0 < 5.0
+        p.unlink()
 
 
 # ----------------------------------------------------------------- lookup
@@ -175,6 +200,107 @@ def test_indices_agree_with_the_reference_formulas(rng):
     edge_i = np.array([[0, 0, 1.0], [0.6, 0, 0.8], [math.sqrt(1 - g * g), 0, g], [0, 0, 1.0]])
     edge_o = np.array([[0, 0, 1.0], [-0.6, 0, 0.8], [0, math.sqrt(1 - g * g), g], [0.6, 0, 0.8]])
     np.testing.assert_array_equal(merl_indices(edge_i, edge_o), reference_index(edge_i, edge_o))
+
+
+def _reference_coords(wi, wo):
+    """The reference's continuous index coordinates (u_θh, u_θd, u_φd) before the floor,
+    and sin θ_d = |(d_x, d_y)|."""
+    h = wi + wo
+    h = h / np.linalg.norm(h, axis=-1, keepdims=True)
+    theta_h = np.arccos(np.clip(h[..., 2], -1, 1))
+    phi_h = np.arctan2(h[..., 1], h[..., 0])
+    d = _rotate(_rotate(wi, np.array([0.0, 0.0, 1.0]), -phi_h), np.array([0.0, 1.0, 0.0]),
+                -theta_h)
+    pd = np.arctan2(d[..., 1], d[..., 0])
+    pd = np.where(pd < 0, pd + np.pi, pd)
+    return (np.sqrt(theta_h / (np.pi / 2) * 8100), np.arccos(np.clip(d[..., 2], -1, 1))
+            / (np.pi / 2) * 90, pd / np.pi * 180, np.hypot(d[..., 0], d[..., 1]))
+
+
+def _adversarial_pairs(rng, n):
+    """Pairs on or within rounding of bin boundaries: θ_h = (k/90)²·π/2, θ_d = k·π/180,
+    φ_d = k·π/180 (k random, all three axes at once), each shifted by 0 or ±1e-16 ...
+    ±1e-10 rad, at φ_h = 0, a multiple of π/2 or random; then pairs in the plane of
+    incidence (d_y = ±0, φ_d = 0 or π), wi = wo (d = n) and normal incidence."""
+    def shift(size):
+        return rng.choice([0.0, 1e-16, 3e-16, 1e-15, 1e-13, 1e-10], size) * rng.choice(
+            [-1.0, 1.0], size)
+
+    th = (rng.integers(0, 91, n) / 90) ** 2 * (np.pi / 2) + np.abs(shift(n))
+    td = rng.integers(0, 91, n) * (np.pi / 180) + np.abs(shift(n))
+    pd = rng.integers(0, 181, n) * (np.pi / 180) + shift(n)
+    wi, wo = half_diff_to_directions(th, td, pd)
+    phi_h = np.where(rng.random(n) < 0.5, rng.integers(0, 4, n) * (np.pi / 2),
+                     rng.random(n) * 2 * np.pi)
+    c, s = np.cos(phi_h)[:, None], np.sin(phi_h)[:, None]
+
+    def rot(w):
+        return np.stack([w[:, 0] * c[:, 0] - w[:, 1] * s[:, 0],
+                         w[:, 0] * s[:, 0] + w[:, 1] * c[:, 0], w[:, 2]], axis=-1)
+
+    m = n // 10
+    ti, to = rng.random(m) * (np.pi / 2), rng.random(m) * (np.pi / 2)
+    po = np.where(rng.random(m) < 0.5, 0.0, np.pi)
+    plane_i = np.stack([np.sin(ti), np.zeros(m), np.cos(ti)], -1)
+    plane_o = np.stack([np.sin(to) * np.cos(po), np.zeros(m), np.cos(to)], -1)
+    same = _random_pairs(rng, m)[0]
+    normal = np.tile([0.0, 0.0, 1.0], (m, 1))
+    return (np.concatenate([rot(wi), plane_i, same, normal, same]),
+            np.concatenate([rot(wo), plane_o, same, same, normal]))
+
+
+def test_fast_index_is_the_formula_index_on_1e7_pairs(rng):
+    """The lookup's index without acos/atan2 (exact step tables + boundary side tests)
+    against the acos/atan2 formulas, bit for bit: 1e7 random pairs, then 1e6 pairs on and
+    within rounding of every kind of bin boundary, where a wrong table or margin shows."""
+    for _ in range(5):
+        # uniform on the hemisphere: normalised Gaussian triples, z made positive (faster
+        # than _random_pairs' trigonometry for this many pairs)
+        g = rng.standard_normal((2, 2_000_000, 3))
+        g[..., 2] = np.abs(g[..., 2])
+        g /= np.sqrt(np.einsum("...k,...k->...", g, g))[..., None]
+        wi, wo = g
+        np.testing.assert_array_equal(merl_indices(wi, wo),
+                                      merl_indices(wi, wo, method="formula"))
+    wi, wo = _adversarial_pairs(rng, 720_000)
+    assert wi.shape[0] >= 1_000_000
+    fast = merl_indices(wi, wo)
+    formula = merl_indices(wi, wo, method="formula")
+    np.testing.assert_array_equal(fast, formula)
+    # tables switched off (as where acos would not step cleanly): the formulas, unchanged
+    from brdfkit.data import _merl_index as mi
+
+    Q = mi._index_tables().copy()
+    Q[mi._Q_OK] = 0.0
+    Q.flags.writeable = False  # the type the compiled loop has already seen
+    out = np.empty(wi.shape[0], dtype=np.int64)
+    mi._indices(wi, wo, Q, out)
+    np.testing.assert_array_equal(out, formula)
+    assert mi._index_tables()[mi._Q_OK] == 1.0  # this machine's acos steps cleanly
+    # and against the reference written above (Rodrigues rotations): an axis's index may
+    # differ only where the reference's coordinate is within rounding of a boundary, as
+    # its formula's conditioning gives it. d carries an absolute error δ ≈ 1e-15 +
+    # 1e-15/sin θ_h (acos near 1: h_z rounded by ~2 ulp moves θ_h by ~4e-16/sin θ_h rad,
+    # which rotates d); θ_h and θ_d then move by ~δ rad (×57.3 bins/rad), φ_d by δ/sin θ_d
+    # (undefined at θ_d = 0, wi = wo; sin θ_d from |(d_x, d_y)|, as acos near 1 would
+    # overstate it). Plus 1e-9 bins for the rest. wi = −wo (h = 0: the reference divides
+    # by 0) is left out.
+    sub = slice(0, 300_000)
+    with np.errstate(divide="ignore", invalid="ignore"):  # h = 0: NaN, left out below
+        ref = reference_index(wi[sub], wo[sub])
+        differ = fast[sub] != ref
+        uh, ud, up, sd = _reference_coords(wi[sub][differ], wo[sub][differ])
+    a, b = fast[sub][differ], ref[differ]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        delta = 1e-15 + 1e-15 / np.sin((uh / 90) ** 2 * (np.pi / 2))
+        tol_theta = 1e-9 + 57.3 * delta
+        tol_phi = 1e-9 + 57.3 * delta / sd
+    defined = np.isfinite(uh)
+    for u, axis, tol in ((uh, a // 16200 != b // 16200, tol_theta),
+                         (ud, (a // 180) % 90 != (b // 180) % 90, tol_theta),
+                         (up, a % 180 != b % 180, tol_phi)):
+        axis &= defined
+        assert np.all(np.abs(u - np.round(u))[axis] < tol[axis])
 
 
 def test_nearest_eval_is_the_reference_lookup(merl_file, rng):
@@ -256,3 +382,41 @@ def test_measured_model_is_a_model(merl_file):
 def test_from_values_rejects_nan():
     with pytest.raises(BrdfkitError, match="finite"):
         MerlTable.from_values(np.full((3, *SHAPE), np.nan))
+
+
+def test_blocked_drivers_equal_the_per_channel_kernel(merl_file, rng):
+    """The blocked 3-channel drivers (bins found, then read) against the per-channel kernel
+    that the engines use (one planar row per channel), called pair by pair: the same
+    values bit for bit, NaN and 0 included, on random pairs with some below the horizon
+    and an unmeasured region."""
+    t = read_binary(merl_file)
+    wi, wo = _random_pairs(rng, 1000)
+    wi[::7, 2] *= -1.0  # below the horizon
+    wi[::5], wo[::5] = half_diff_to_directions(bin_centres()[0][5], np.radians(85.0),
+                                               rng.random(200) * np.pi)  # unmeasured bins
+    for lookup in ("nearest", "linear"):
+        m = MeasuredBRDF(t, lookup=lookup)
+        want = np.array([[m.kernel(*a, *b, m.packed[c]) for c in range(3)]
+                         for a, b in zip(wi, wo, strict=True)])
+        assert (want == 0).any()  # below the horizon
+        # unmeasured: NaN (nearest); linear interpolates from the measured θ_h neighbours
+        assert np.isnan(want).any() == (lookup == "nearest")
+        np.testing.assert_array_equal(m.eval(wi, wo), want)
+
+
+def test_bin_centre_pairs_are_half_diff_to_directions():
+    """table_from_function's compiled bin-centre pairs: bit for bit the NumPy
+    half_diff_to_directions at the bin_centres grid (the documented convention)."""
+    from brdfkit.data.merl import _centre_pairs
+
+    th, td, pd = bin_centres()
+    wi, wo = half_diff_to_directions(*np.meshgrid(th, td, pd, indexing="ij"))
+    wi, wo = wi.reshape(-1, 3), wo.reshape(-1, 3)
+    up = (wi[:, 2] > 0) & (wo[:, 2] > 0)
+    a, b, u = np.empty((N_BINS, 3)), np.empty((N_BINS, 3)), np.empty(N_BINS, dtype=bool)
+    m = _centre_pairs(np.sin(th), np.cos(th), np.sin(td), np.cos(td), np.sin(pd),
+                      np.cos(pd), a, b, u)
+    np.testing.assert_array_equal(u, up)
+    assert m == up.sum() == 1_096_216
+    np.testing.assert_array_equal(a[:m], wi[up])
+    np.testing.assert_array_equal(b[:m], wo[up])

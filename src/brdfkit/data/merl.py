@@ -33,6 +33,10 @@ index = i_φd + 180·i_θd + 180·90·i_θh. The ``linear`` lookup interpolates
 trilinearly between bin centres in these index coordinates (u_θh = √(θ_h/(π/2))·90,
 u_θd = θ_d/(π/2)·90, u_φd = φ_d/π·180; centres at i + ½; θ_h and θ_d clamped at
 the ends, φ_d periodic with period π — φ_d and φ_d + π are the same bin).
+The compiled lookups find the same ``nearest`` bin without acos/atan2
+(exact step tables of h_z and d_z, φ_d boundary side tests:
+:mod:`brdfkit.data._merl_index`), in blocks whose bins are found first and
+then read (random reads of the 35 MB table overlap).
 
 Public objects
 --------------
@@ -62,6 +66,19 @@ import numba
 import numpy as np
 
 from brdfkit._io import write_atomic
+from brdfkit.data._merl_index import (
+    _NQ,
+    _fast_index,
+    _half_diff,
+    _half_diff_vec,
+    _index_tables,
+    _indices,
+    _indices_formula,
+    _linear,
+    _linear_coords,
+    _linear_sum,
+    _nearest_index,
+)
 from brdfkit.data.sampler import TabulatedSampler
 from brdfkit.errors import DataFileError, ParameterError
 from brdfkit.models._base import DerivedBRDF, Lobe, Param, _unit_pair
@@ -186,121 +203,37 @@ def write_binary(path, table) -> str:
 
 
 # --------------------------------------------------------------------------- lookup
-@numba.njit(cache=True, inline="always")
-def _half_diff(ix, iy, iz, ox, oy, oz):
-    """(θ_h, θ_d, φ_d) of the pair, as the reference reader computes them.
+# the index arithmetic (half/difference angles, bins, the fast index, trilinear cells) is
+# in brdfkit.data._merl_index
 
-    The reference takes φ_h = atan2(h_y, h_x) and rotates by −φ_h and −θ_h with
-    cos/sin of those angles; here cos φ_h = h_x/ρ, sin φ_h = h_y/ρ (ρ = √(h_x² + h_y²)),
-    cos θ_h = h_z, sin θ_h = ρ — the same rotations from the components, with three
-    transcendental calls instead of eight (the indices agree with the reference's on
-    every tested pair; a difference needs a value within rounding of a bin boundary).
+
+def merl_indices(wi, wo, *, method: str = "fast") -> np.ndarray:
+    """Flat bin index (``i_φd + 180 i_θd + 16200 i_θh``) of each pair, as ``BRDFRead.cpp``.
+
+    ``method="formula"`` evaluates the reference's acos/atan2 formulas; ``"fast"`` (what
+    :class:`MeasuredBRDF` uses) gives the same indices without them (see _fast_index).
     """
-    hx = ix + ox
-    hy = iy + oy
-    hz = iz + oz
-    n = math.sqrt(hx * hx + hy * hy + hz * hz)
-    if n <= 0.0:
-        return 0.0, 0.5 * math.pi, 0.0  # wi = −wo: only below the horizon
-    hx /= n
-    hy /= n
-    hz /= n
-    theta_h = math.acos(min(1.0, max(-1.0, hz)))
-    rho = math.sqrt(hx * hx + hy * hy)
-    if rho > 0.0:
-        cp, sp = hx / rho, hy / rho  # cos φ_h, sin φ_h
-    else:
-        cp, sp = 1.0, 0.0  # h = N: atan2(0, 0) = 0
-    # rotate wi about the normal by −φ_h, then about the binormal (y) by −θ_h
-    tx = ix * cp + iy * sp
-    ty = iy * cp - ix * sp
-    tz = iz
-    ct, st = hz, rho  # cos θ_h, sin θ_h (θ_h ∈ [0, π])
-    dx = tx * ct - tz * st
-    dy = ty
-    dz = tz * ct + tx * st
-    theta_d = math.acos(min(1.0, max(-1.0, dz)))
-    phi_d = math.atan2(dy, dx)
-    return theta_h, theta_d, phi_d
-
-
-@numba.njit(cache=True, inline="always")
-def _nearest_index(theta_h, theta_d, phi_d):
-    if theta_h <= 0.0:
-        ih = 0
-    else:
-        ih = int(math.sqrt(theta_h / (0.5 * math.pi) * 90.0 * 90.0))
-    ih = min(max(ih, 0), 89)
-    idd = min(max(int(theta_d / (0.5 * math.pi) * 90.0), 0), 89)
-    if phi_d < 0.0:
-        phi_d += math.pi
-    ip = min(max(int(phi_d / math.pi * 180.0), 0), 179)
-    return ip + 180 * idd + 180 * 90 * ih
-
-
-@numba.njit(cache=True)
-def _indices(wi, wo, out):  # pragma: no cover - compiled
-    for j in range(wi.shape[0]):
-        th, td, pd = _half_diff(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2])
-        out[j] = _nearest_index(th, td, pd)
-
-
-def merl_indices(wi, wo) -> np.ndarray:
-    """Flat bin index (``i_φd + 180 i_θd + 16200 i_θh``) of each pair, as ``BRDFRead.cpp``."""
     from brdfkit._array import as_directions
 
+    if method not in ("fast", "formula"):
+        raise ParameterError(f"merl_indices: method must be 'fast' or 'formula'; got "
+                             f"{method!r}")
     wi = as_directions(wi, "wi")
     wo = as_directions(wo, "wo")
     shape = np.broadcast_shapes(wi.shape, wo.shape)
     a = np.ascontiguousarray(np.broadcast_to(wi, shape).reshape(-1, 3))
     b = np.ascontiguousarray(np.broadcast_to(wo, shape).reshape(-1, 3))
     out = np.empty(a.shape[0], dtype=np.int64)
-    _indices(a, b, out)
+    if method == "fast":
+        _indices(a, b, _index_tables(), out)
+    else:
+        _indices_formula(a, b, out)
     return out.reshape(shape[:-1])
 
 
 #: Offset of the table in a packed row: [lookup mode, table …].
 _TABLE = 1
 NEAREST, LINEAR = 0, 1
-
-
-@numba.njit(cache=True, inline="always")
-def _linear(t, stride, offset, theta_h, theta_d, phi_d):
-    """Trilinear interpolation between bin centres of the table whose bin i is
-    ``t[offset + stride·i]`` (a planar row: stride 1; the channel-interleaved table: stride
-    C). NaN (unmeasured) neighbours are left out and the weights of the others
-    renormalised; NaN when all eight are unmeasured."""
-    uh = math.sqrt(max(theta_h, 0.0) / (0.5 * math.pi)) * 90.0 - 0.5
-    ud = theta_d / (0.5 * math.pi) * 90.0 - 0.5
-    if phi_d < 0.0:
-        phi_d += math.pi
-    up = phi_d / math.pi * 180.0 - 0.5
-    # θ_h, θ_d: clamp to the centres of the end bins; φ_d: periodic (period 180 bins)
-    uh = min(max(uh, 0.0), 89.0)
-    ud = min(max(ud, 0.0), 89.0)
-    h0 = min(int(uh), 88)
-    d0 = min(int(ud), 88)
-    fp = math.floor(up)
-    p0 = int(fp) % 180
-    th = uh - h0
-    td = ud - d0
-    tp = up - fp
-    acc = 0.0
-    wsum = 0.0
-    for a in range(2):
-        wa = th if a == 1 else 1.0 - th
-        for b in range(2):
-            wb = td if b == 1 else 1.0 - td
-            for c in range(2):
-                wc = tp if c == 1 else 1.0 - tp
-                w = wa * wb * wc
-                v = t[offset + stride * ((p0 + c) % 180 + 180 * (d0 + b) + 16200 * (h0 + a))]
-                if v == v and w > 0.0:  # v == v: not NaN (an unmeasured bin)
-                    acc += w * v
-                    wsum += w
-    if wsum <= 0.0:
-        return math.nan
-    return acc / wsum
 
 
 @numba.njit(cache=True)
@@ -313,39 +246,104 @@ def _measured_kernel(ix, iy, iz, ox, oy, oz, p):
     return p[_TABLE + _nearest_index(theta_h, theta_d, phi_d)]
 
 
+#: Pairs per task of the table drivers: the bins of a block are found first (arithmetic),
+#: then read (random reads of a 35 MB table, cache and TLB misses): the reads of a block
+#: are independent, so the memory system serves many at once (measured on this 2-core
+#: machine: 1.7-2.2x one loop that finds and reads each pair's bin in turn).
+_BLOCK = 256
+_BAD, _BELOW = -2, -1  # block markers: not a finite unit pair; below the horizon
+
+
+@numba.njit(cache=True, inline="always")
+def _status(ix, iy, iz, ox, oy, oz):
+    """0 for a pair to look up, _BAD (not finite unit vectors), _BELOW (f_r = 0)."""
+    if not _unit_pair(ix, iy, iz, ox, oy, oz):
+        return _BAD
+    if iz <= 0.0 or oz <= 0.0:
+        return _BELOW
+    return 0
+
+
+@numba.njit(cache=True, inline="always")
+def _fill(out, j, n_channels, status):
+    """Row j of a pair that is not looked up: NaN (bad) or 0 (below the horizon)."""
+    v = math.nan if status == _BAD else 0.0
+    for c in range(n_channels):
+        out[j, c] = v
+
+
 @numba.njit(cache=True, parallel=True)
-def _measured_driver(wi, wo, T, out):  # pragma: no cover - compiled
-    """:meth:`BRDF.eval`'s checked pass for a table, reading the channel-interleaved table
-    ``T`` (1 + N_BINS, C) (row 0: the lookup mode; row 1 + i: bin i's channels): the bin
-    is computed once per pair for all channels and its channels share one cache line (the
-    generic loop around :func:`_measured_kernel` computes it per channel and reads three
-    planar rows: ~3 cache and TLB misses per pair on random pairs). Returns the number of
-    pairs that are not finite unit vectors (their rows NaN), as the generic driver does."""
+def _nearest_driver(wi, wo, data, out):  # pragma: no cover - compiled
+    """:meth:`BRDF.eval`'s checked pass for the ``nearest`` lookup. ``data`` (flat): the
+    index tables (:func:`_index_tables`, _NQ numbers), then the channel-interleaved table
+    (bin i, channel c at ``_NQ + C·i + c``): the bin is found once per pair for all
+    channels, whose values share a cache line (the generic loop around
+    :func:`_measured_kernel` finds it per channel and reads three planar rows: ~3 cache
+    and TLB misses per random pair). Blocks of _BLOCK pairs. Returns the number of pairs
+    that are not finite unit vectors (their rows NaN), as the generic driver does."""
     n = wi.shape[0]
-    n_channels = T.shape[1]
-    linear = T[0, 0] == LINEAR
-    flat = T.reshape(T.size)  # bin i, channel c at flat[C·(1 + i) + c]
+    n_channels = out.shape[1]
+    Q = data[:_NQ]
     n_bad = 0
-    for j in numba.prange(n):
-        ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
-        ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-        if not _unit_pair(ix, iy, iz, ox, oy, oz):
-            for c in range(n_channels):
-                out[j, c] = math.nan
-            n_bad += 1
-        elif iz <= 0.0 or oz <= 0.0:
-            for c in range(n_channels):
-                out[j, c] = 0.0
-        else:
-            theta_h, theta_d, phi_d = _half_diff(ix, iy, iz, ox, oy, oz)
-            if linear:
-                for c in range(n_channels):
-                    out[j, c] = _linear(flat, n_channels, n_channels + c, theta_h, theta_d,
-                                        phi_d)
+    for q in numba.prange((n + _BLOCK - 1) // _BLOCK):
+        lo = q * _BLOCK
+        hi = min(n, lo + _BLOCK)
+        k = np.empty(_BLOCK, dtype=np.int64)  # the bin's offset in data, or a marker
+        for j in range(lo, hi):
+            ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
+            ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
+            s = _status(ix, iy, iz, ox, oy, oz)
+            if s == 0:
+                hz, dx, dy, dz = _half_diff_vec(ix, iy, iz, ox, oy, oz)
+                k[j - lo] = _NQ + n_channels * _fast_index(hz, dx, dy, dz, Q)
             else:
-                k = 1 + _nearest_index(theta_h, theta_d, phi_d)
+                k[j - lo] = s
+        for j in range(lo, hi):
+            kj = k[j - lo]
+            if kj >= 0:
                 for c in range(n_channels):
-                    out[j, c] = T[k, c]
+                    out[j, c] = data[kj + c]
+            else:
+                _fill(out, j, n_channels, kj)
+                if kj == _BAD:
+                    n_bad += 1
+    return n_bad
+
+
+@numba.njit(cache=True, parallel=True)
+def _linear_driver(wi, wo, data, out):  # pragma: no cover - compiled
+    """:func:`_nearest_driver` for the ``linear`` lookup (the same ``data``): the cell and
+    weights are computed once per pair for all channels."""
+    n = wi.shape[0]
+    n_channels = out.shape[1]
+    n_bad = 0
+    for q in numba.prange((n + _BLOCK - 1) // _BLOCK):
+        lo = q * _BLOCK
+        hi = min(n, lo + _BLOCK)
+        k = np.empty(_BLOCK, dtype=np.int64)  # the cell's first corner, or a marker
+        step = np.empty(_BLOCK, dtype=np.int64)
+        frac = np.empty((_BLOCK, 3))
+        for j in range(lo, hi):
+            ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
+            ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
+            s = _status(ix, iy, iz, ox, oy, oz)
+            if s == 0:
+                theta_h, theta_d, phi_d = _half_diff(ix, iy, iz, ox, oy, oz)
+                i = j - lo
+                k[i], step[i], frac[i, 0], frac[i, 1], frac[i, 2] = _linear_coords(
+                    theta_h, theta_d, phi_d)
+            else:
+                k[j - lo] = s
+        for j in range(lo, hi):
+            i = j - lo
+            if k[i] >= 0:
+                for c in range(n_channels):
+                    out[j, c] = _linear_sum(data, n_channels, _NQ + c, k[i], step[i],
+                                            frac[i, 0], frac[i, 1], frac[i, 2])
+            else:
+                _fill(out, j, n_channels, k[i])
+                if k[i] == _BAD:
+                    n_bad += 1
     return n_bad
 
 
@@ -374,20 +372,68 @@ def half_diff_to_directions(theta_h, theta_d, phi_d) -> tuple[np.ndarray, np.nda
     return wi, wo
 
 
+@numba.njit(cache=True)
+def _centre_pairs(sh, ch, sd, cd, sp, cp, wi, wo, up):  # pragma: no cover - compiled
+    """:func:`half_diff_to_directions` at every bin centre (the same operations in the same
+    order, from the per-axis sines and cosines), the pairs with both directions above the
+    horizon packed into the first rows of ``wi``, ``wo`` (N_BINS, 3); ``up`` (N_BINS,) marks
+    their bins. Returns their number."""
+    m = 0
+    for ih in range(90):
+        c, s = ch[ih], sh[ih]  # h = (sin θ_h, 0, cos θ_h)
+        for idd in range(90):
+            for ip in range(180):
+                d0 = sd[idd] * cp[ip]
+                d1 = sd[idd] * sp[ip]
+                d2 = cd[idd]
+                # wi = rot_y(θ_h) d; wo = 2 (wi·h) h − wi
+                a0 = d0 * c + d2 * s
+                a1 = d1
+                a2 = d2 * c - d0 * s
+                t2 = 2.0 * ((a0 * s + a1 * 0.0) + a2 * c)
+                b0 = t2 * s - a0
+                b1 = t2 * 0.0 - a1
+                b2 = t2 * c - a2
+                k = ip + 180 * idd + 16200 * ih
+                ok = a2 > 0.0 and b2 > 0.0
+                up[k] = ok
+                if ok:
+                    wi[m, 0], wi[m, 1], wi[m, 2] = a0, a1, a2
+                    wo[m, 0], wo[m, 1], wo[m, 2] = b0, b1, b2
+                    m += 1
+    return m
+
+
+@numba.njit(cache=True)
+def _scatter(vals, up, scales, raw):  # pragma: no cover - compiled
+    """raw[c, k] = (the next row of vals)[c] / scales[c] where up[k], else −1 (unmeasured)."""
+    m = 0
+    for k in range(up.shape[0]):
+        if up[k]:
+            for c in range(3):
+                raw[c, k] = vals[m, c] / scales[c]
+            m += 1
+        else:
+            for c in range(3):
+                raw[c, k] = -1.0
+
+
 def table_from_function(f, *, source: str = "<function>") -> MerlTable:
     """Tabulate ``f(wi, wo) -> (N,) or (N, 3)`` (f_r in 1/sr) at the MERL bin centres.
 
     Bin-centre convention: each bin is evaluated at the centre of its index
-    coordinates (:func:`bin_centres`), φ_h = 0. Bins whose ω_i or ω_o is at or
-    below the horizon are marked unmeasured (raw −1), as in MERL files.
+    coordinates (:func:`bin_centres`), φ_h = 0 (the directions of
+    :func:`half_diff_to_directions`). Bins whose ω_i or ω_o is at or below the
+    horizon are marked unmeasured (raw −1), as in MERL files. *f* is called once,
+    on the 1,096,216 pairs above the horizon.
     """
     th, td, pd = bin_centres()
-    TH, TD, PD = np.meshgrid(th, td, pd, indexing="ij")
-    wi, wo = half_diff_to_directions(TH, TD, PD)
-    wi = wi.reshape(-1, 3)
-    wo = wo.reshape(-1, 3)
-    up = (wi[:, 2] > 0.0) & (wo[:, 2] > 0.0)
-    vals = np.asarray(f(wi[up], wo[up]), dtype=np.float64)
+    wi = np.empty((N_BINS, 3))
+    wo = np.empty((N_BINS, 3))
+    up = np.empty(N_BINS, dtype=np.bool_)
+    m = _centre_pairs(np.sin(th), np.cos(th), np.sin(td), np.cos(td), np.sin(pd), np.cos(pd),
+                      wi, wo, up)
+    vals = np.asarray(f(wi[:m], wo[:m]), dtype=np.float64)
     vals = vals.reshape(vals.shape[0], -1)
     if vals.shape[1] == 1:
         vals = np.repeat(vals, 3, axis=1)
@@ -396,8 +442,9 @@ def table_from_function(f, *, source: str = "<function>") -> MerlTable:
                              f"{vals.shape[1]} channels")
     if not np.all(np.isfinite(vals)):
         raise ParameterError("table_from_function: f returned NaN or inf above the horizon")
-    raw = np.full((3, N_BINS), -1.0)
-    raw[:, up] = vals.T / SCALES[:, None]
+    raw = np.empty((3, N_BINS))
+    _scatter(vals, up, SCALES, raw)
+    raw.flags.writeable = False  # MerlTable keeps a read-only array as it is (no copy)
     return MerlTable(raw.reshape(3, *SHAPE), source)
 
 
@@ -526,7 +573,9 @@ class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
             reciprocal=True, has_sampler=True, kernel=_measured_kernel,
             isotropic=_mirror_symmetric(values))
         self.n_channels = 3
-        self._driver = _measured_driver  # one bin computation per pair for all channels
+        # one bin computation per pair for all channels
+        self._driver = (_linear_driver if self._values["lookup"] == "linear"
+                        else _nearest_driver)
 
     def _pack(self) -> np.ndarray:
         mode = LINEAR if self._values["lookup"] == "linear" else NEAREST
@@ -536,11 +585,13 @@ class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
         return out
 
     def _driver_data(self) -> np.ndarray:
-        """The channel-interleaved table :func:`_measured_driver` reads (built once)."""
+        """What :func:`_nearest_driver` and :func:`_linear_driver` read (built once): the
+        index tables, then the channel-interleaved table."""
         if self._interleaved is None:
-            t = np.empty((1 + N_BINS, 3))
-            t[0] = self._packed[0, 0]  # the lookup mode
-            t[1:] = self._values_table.T
+            t = np.empty(_NQ + 3 * N_BINS)
+            t[:_NQ] = _index_tables()
+            t[_NQ:] = self._values_table.T.reshape(-1)
+            t.flags.writeable = False
             self._interleaved = t
         return self._interleaved
 
