@@ -394,7 +394,7 @@ def test_figure_building_line_when_interactive(monkeypatch, tmp_path):
     assert r.exit_code == 0, r.stderr
     assert r.stderr.startswith("building lewis-fig5 ...") and " done (" in r.stderr
     assert r.stdout.strip() == out
-    assert written == [("lewis-fig5", out, {"dpi": 150, "option": "--out"})]
+    assert written == [("lewis-fig5", out, {"dpi": 150, "option": "--out", "models": ()})]
 
 
 # --------------------------------------------------------------------------- structure
