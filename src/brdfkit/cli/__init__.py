@@ -15,6 +15,7 @@ the command modules import :mod:`brdfkit.cli._common` and never this module.
 
 - :mod:`brdfkit.cli.model_commands` — ``models``, ``eval``.
 - :mod:`brdfkit.cli.analysis` — ``albedo``, ``check``, ``table2``, ``figure``.
+- :mod:`brdfkit.cli.fit_commands` — ``fit``.
 - :mod:`brdfkit.cli._group` — the group class (one-line errors, SIGTERM).
 - :mod:`brdfkit.cli._common` — model options, directions, JSON.
 - :mod:`brdfkit.cli._progress` — progress on stderr.
@@ -34,6 +35,7 @@ import click
 import brdfkit
 from brdfkit.cli._group import BrdfkitGroup
 from brdfkit.cli.analysis import albedo_cmd, check_cmd, figure_cmd, table2_cmd
+from brdfkit.cli.fit_commands import fit_cmd
 from brdfkit.cli.model_commands import eval_cmd, models_cmd
 
 __all__ = ["main"]
@@ -55,3 +57,4 @@ main.add_command(albedo_cmd)
 main.add_command(check_cmd)
 main.add_command(table2_cmd)
 main.add_command(figure_cmd)
+main.add_command(fit_cmd)
