@@ -82,12 +82,11 @@ STATUS_MESSAGES = {
     MAX_EVALS: "evaluation limit reached before the tolerance",
     NONFINITE: "the fitted model is not finite on the samples",
 }
-#: Nelder–Mead tolerances: on z (the reparametrised coordinates) and on the loss relative
-#: to its value at the start of the stage.
-XATOL, FRTOL = 1e-3, 1e-5
-#: Stage (iii) starts at stage (ii)'s optimum and polishes: a coarser z tolerance (1 % of a
-#: log-parametrised value) ends it when the simplex stops moving.
-XATOL_POLISH = 1e-2
+#: Nelder–Mead stops when the losses at the simplex's vertices agree to this fraction of
+#: the first guess's loss (stage ii; stage iii, a polish from a stationary point, at
+#: FRTOL_POLISH). A criterion on the loss only: along flat directions (e.g. Lafortune's
+#: common scale of C_xy, C_z against rho_s) there is no parameter tolerance to reach.
+FRTOL, FRTOL_POLISH = 1e-6, 1e-5
 #: Two stage-(ii) runs whose losses agree to this relative difference are one optimum.
 CONSENSUS = 1e-4
 
@@ -172,18 +171,26 @@ def _measured_half_width(target) -> float:
     return float(th[below[0]]) if below.size else math.pi / 4
 
 
-def _nelder_mead(fun, z0, steps, maxfev, scale, xatol=None):
+def _nelder_mead(fun, z0, steps, maxfev, scale, fatol):
     """Nelder–Mead from z0 with an initial simplex of the given steps; the loss is
     divided by *scale* (the loss at the first guess, before any stage: a change below
-    FRTOL of it is negligible, also where the loss tends to 0 on exact data). Returns
-    (z, value, n_evaluations, hit_limit)."""
+    FRTOL of it is negligible, also where the loss tends to 0 on exact data). A run that
+    reaches *maxfev* is restarted once from its best point with a fresh simplex (the
+    standard remedy for a collapsed simplex). Returns (z, value, n_evaluations,
+    hit_limit: the restart reached the limit too)."""
     z0 = np.asarray(z0, dtype=np.float64)
     n = z0.size
-    simplex = np.vstack([z0] + [z0 + np.eye(n)[k] * steps[k] for k in range(n)])
-    res = minimize(lambda z: fun(z) / scale, z0, method="Nelder-Mead",
-                   options={"initial_simplex": simplex, "maxfev": maxfev, "xatol": xatol or XATOL,
-                            "fatol": FRTOL, "adaptive": n > 2})
-    return res.x, float(res.fun) * scale, int(res.nfev), res.nfev >= maxfev
+    nfev = 0
+    for _ in range(2):  # a run that hits the limit is restarted once from its best point
+        simplex = np.vstack([z0] + [z0 + np.eye(n)[k] * steps[k] for k in range(n)])
+        res = minimize(lambda z: fun(z) / scale, z0, method="Nelder-Mead",
+                       options={"initial_simplex": simplex, "maxfev": maxfev, "xatol": math.inf,
+                                "fatol": fatol, "adaptive": n > 2})
+        nfev += int(res.nfev)
+        if res.nfev < maxfev:
+            break
+        z0 = res.x
+    return res.x, float(res.fun) * scale, nfev, res.nfev >= maxfev
 
 
 def _free_coords(model, fixed, C):
@@ -387,7 +394,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
             else:
                 def obj(z):
                     return prob.loss_at(from_vector(z, shape, values))
-            z, val, nfev, limit = _nelder_mead(obj, z0, steps, budget, scale)
+            z, val, nfev, limit = _nelder_mead(obj, z0, steps, budget, scale, FRTOL)
             end = from_vector(z, shape, values)
             if procedure == "staged" and linear:
                 end = solve_at(end) or end
@@ -418,7 +425,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         steps = 0.1 * np.array([c.step(_val(values, c)) for c in free3])
         z, val, _, limit = _nelder_mead(lambda z: prob.loss_at(from_vector(z, free3, values)),
                                         as_vector(values, free3), steps,
-                                        max(max_evals, 40 * len(free3)), scale, XATOL_POLISH)
+                                        max(max_evals, 40 * len(free3)), scale, FRTOL_POLISH)
         if val <= before:
             values = from_vector(z, free3, values)
         hit_limit |= limit
