@@ -45,13 +45,17 @@ def main():
         target = brdfkit.data.material(spec)
         for name in a.models.split(","):
             m = build(name)
+            lobes = {p.name for p in m.params if p.kind == "lobes"}
             t0 = time.perf_counter()
             starts = a.pumped_starts if name.startswith("pumped") else 3
             r = fit(m, target, loss=a.loss, n_starts=starts)
             dt = time.perf_counter() - t0
+            # scalar and per-lobe parameters (the per-channel ones are in the JSON)
             shape = {k: v for k, v in r.params.items()
-                     if not isinstance(v, list) and isinstance(v, float)}
-            txt = ", ".join(f"{k}={v:.4g}" for k, v in shape.items())
+                     if isinstance(v, float) or (isinstance(v, list) and k in lobes)}
+            txt = ", ".join(
+                f"{k}=" + ("/".join(f"{x:.4g}" for x in v) if isinstance(v, list) else f"{v:.4g}")
+                for k, v in shape.items())
             ok = all(np.isfinite(v) for v in r.metrics.values())
             print(f"| {spec} | {name} | {r.metrics['l1']:.4g} | {r.metrics['l2']:.4g} | "
                   f"{r.metrics['perceptual']:.3g} | {txt} | {dt:.1f} | "

@@ -15,18 +15,12 @@ parameters. This is tested numerically on the samples (a random combination
 must equal f₀ + Σ c_k B_k to 10⁻⁶ of its largest value), so no model is named: ρ_d, ρ_s, k_s of
 the Phong family, Ward and Lafortune pass; a pumped model (f/g, with g
 depending on them) does not. For fixed shape parameters the linear ones are
-solved per channel in closed form:
-
-- L2 (``l2``, ``ngan``; also the first guess for ``log`` and
-  ``perceptual``): the box-constrained least squares min Σ w (A p − r)² with
-  A_jk = cos θ_i B_jk, r = y − cos θ_i f₀, lower ≤ p ≤ upper, solved exactly
-  by trying every active set (each p_k free, at its lower or at its upper
-  bound: 3^K small systems, K ≤ 3 here) and keeping the best feasible one;
-- L1 (``l1``): iteratively reweighted least squares (IRLS) with weights
-  w_j / max(|residual_j|, ε) (ε = 10⁻⁹ × the mean |r|: the reweighting of
-  an exactly fitted sample is bounded), each step the box solve above,
-  :data:`IRLS_ITERATIONS` steps from the L2 solution (the L1 objective
-  decreases monotonically along IRLS steps).
+solved per channel in closed form (:mod:`brdfkit.fitting._linear`): the
+box-constrained least squares exactly (``l2``, ``ngan``; also the inner solve
+for ``log`` and ``perceptual``, whose stage iii then optimises everything
+under the loss itself), L1 (``l1``) by iteratively reweighted least squares
+from the L2 solution, warm-started from the previous solution
+(:data:`IRLS_ITERATIONS` steps at most).
 """
 
 from __future__ import annotations
