@@ -447,7 +447,8 @@ def _jsonable(values, coords) -> dict:
 
 
 def _inert(prob, coords, values) -> set:
-    """Names of parameters whose change (20 % in z-step terms) changes no sample value."""
+    """Names of parameters that change no sample value when moved by five z-steps, or
+    that the model refuses to move alone."""
     _, base = prob.predict(values)
     out = set()
     for name in dict.fromkeys(c.name for c in coords):
@@ -455,7 +456,9 @@ def _inert(prob, coords, values) -> set:
         z = as_vector(values, cs)
         steps = np.array([c.step(_val(values, c)) for c in cs])
         _, moved = prob.predict(from_vector(z + 5.0 * steps, cs, values))
-        if base is not None and moved is not None and np.array_equal(base, moved):
+        # held: no effect, or refused when moved alone (e.g. an extinction coefficient k
+        # without an index eta: the model's own cross-parameter check)
+        if moved is None or (base is not None and np.array_equal(base, moved)):
             out.add(name)
     return out
 
