@@ -429,7 +429,7 @@ def test_cli_command_modules_do_not_import_the_cli_package():
         bad = {m for m in _imports(path) if m in ("brdfkit.cli", "brdfkit.cli.main")}
         assert not bad, (path.name, bad)
     assert set(main.commands) == {"models", "eval", "albedo", "check", "table2", "figure",
-                                  "render", "materials", "export", "explore"}
+                                  "render", "materials", "export", "explore", "fit"}
     assert set(main.commands["render"].commands) == {"sphere"}
 
 

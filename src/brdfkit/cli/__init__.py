@@ -18,6 +18,7 @@ the command modules import :mod:`brdfkit.cli._common` and never this module.
 - :mod:`brdfkit.cli.data_commands` — ``materials``, ``export``.
 - :mod:`brdfkit.cli.explore_commands` — ``explore`` (the browser app).
 - :mod:`brdfkit.cli.render_commands` — ``render sphere``.
+- :mod:`brdfkit.cli.fit_commands` — ``fit``.
 - :mod:`brdfkit.cli._group` — the group class (one-line errors, SIGTERM).
 - :mod:`brdfkit.cli._common` — model options, directions, JSON.
 - :mod:`brdfkit.cli._progress` — progress on stderr.
@@ -39,6 +40,7 @@ from brdfkit.cli._group import BrdfkitGroup
 from brdfkit.cli.analysis import albedo_cmd, check_cmd, figure_cmd, table2_cmd
 from brdfkit.cli.data_commands import export_cmd, materials_cmd
 from brdfkit.cli.explore_commands import explore_cmd
+from brdfkit.cli.fit_commands import fit_cmd
 from brdfkit.cli.model_commands import eval_cmd, models_cmd
 from brdfkit.cli.render_commands import render_group, sphere_cmd
 
@@ -66,3 +68,4 @@ main.add_command(export_cmd)
 main.add_command(explore_cmd)
 render_group.add_command(sphere_cmd)
 main.add_command(render_group)
+main.add_command(fit_cmd)

@@ -18,6 +18,8 @@ Layout (imports go downward only)
   (``neumann-fig1``), :mod:`~brdfkit.figures.pumping` (``neumann-fig3`` …
   ``neumann-fig7``) — plain figure functions; they import the library, never
   :mod:`brdfkit.figures`.
+- :mod:`~brdfkit.figures.fitting` — :func:`~brdfkit.figures.fitting.fit_figure`, the
+  figure of one fit (``brdfkit fit --plot``; it takes a result, so it is not registered).
 - :mod:`~brdfkit.figures._registry` — :data:`FIGURES`, the explicit list of
   name → function, :data:`MODEL_FIGURES` (figures of given models, e.g.
   ``slices`` in :mod:`~brdfkit.figures.models`), and the functions that use them.

@@ -1,0 +1,200 @@
+"""
+Where a fit looks: MERL-grid samples, their measure, and an albedo quadrature
+=============================================================================
+
+Samples
+-------
+A fit compares model and target at the centres of MERL's bins (Matusik et
+al. 2003; :func:`brdfkit.data.merl.bin_centres`): 90 θ_h bins with the
+quadratic spacing θ_h = (u/90)²·π/2, 90 θ_d bins, 180 φ_d bins over [0, π)
+(reciprocity folds φ_d ∈ [π, 2π) onto them). Each bin is weighted by its
+measure in (ω_i, ω_o):
+
+    dω_i dω_o = 4 cos θ_d dω_h dω_d                                   (1)
+
+(for fixed ω_i, ω_o = 2(ω_i·h)h − ω_i gives dω_o = 4 (ω_i·h) dω_h, and
+(ω_i, h) ↦ (h, ω_d) is a rotation of ω_i for each h, so it keeps the
+measure; Rusinkiewicz 1998). With dω_h = sin θ_h dθ_h dφ_h, dω_d =
+sin θ_d dθ_d dφ_d and φ_h integrated over 2π (isotropy), bin (a, b, c) with
+edges θ_h ∈ [h_a, h_a+1], θ_d ∈ [d_b, d_b+1], φ_d ∈ [p_c, p_c+1] has the
+exact measure
+
+    W_abc = 8π (cos h_a − cos h_a+1) · ½(sin² d_b+1 − sin² d_b) · (p_c+1 − p_c)   (2)
+
+Summed over all bins, (2) is 8π · 1 · ½ · π = 4π², the measure of the
+pairs with h in the upper hemisphere folded to φ_d ∈ [0, π) (half of all
+pairs of directions, (4π)²/2 = 8π², folded: 4π²). The pairs with both
+directions above the horizon have measure (2π)² = 4π², folded 2π²: the
+valid bins' weights sum to that up to the bins the horizon cuts
+(tests/test_fitting.py checks both).
+
+A sample is kept when both directions of its bin centre are above the
+horizon (and, with ``theta_max``, both θ ≤ θ_max: Ngan et al. 2005 cut at
+80°) and the target is finite there (a MERL file's unmeasured bins are
+dropped, never read as 0).
+
+Subsampling (speed)
+-------------------
+The full grid has 1,096,216 bins with both directions above the horizon.
+:func:`merl_samples` merges bins
+into cells — every θ_h bin is kept (the quadratic spacing is what resolves
+sharp highlights), ``stride_d`` θ_d bins and ``stride_p`` φ_d bins per cell
+— evaluated at the centre bin of each cell and weighted by the exact measure
+(2) of the whole cell. Deterministic (no random choice). With odd-sized
+cells' centres on bin centres — the default (9, 15): 10 θ_d × 12 φ_d cells,
+centres at θ_d bins 4, 13, …, φ_d bins 7, 22, … — a MERL table is read at
+exactly its stored bins. The default keeps ~8,000 samples.
+
+Albedo quadrature
+-----------------
+The directional albedo a(θ_i) = ∫ f cos θ_o dω_o is integrated over the
+half vector: ω_o = 2(ω_i·h)h − ω_i, dω_o = 4 (ω_i·h) dω_h, with θ_h =
+u²·π/2 (midpoint rule in u, the MERL spacing, dense at h = n where every
+mirror-centred lobe peaks) and midpoints in φ_h ∈ [0, π], doubled (f is
+even in φ_h for an isotropic model and ω_i in the xz-plane). Model and
+target are integrated with the same nodes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from brdfkit.data.merl import SHAPE, half_diff_to_directions
+from brdfkit.errors import ParameterError
+
+__all__ = ["Samples", "bin_measure", "merl_samples", "albedo_nodes", "albedo_from_values",
+           "DEFAULT_STRIDES", "ALBEDO_THETA_DEG"]
+
+#: Default merging of bins per cell along (θ_d, φ_d) (θ_h is never merged).
+DEFAULT_STRIDES = (9, 15)
+#: Incidence angles of the reported albedo curves, degrees.
+ALBEDO_THETA_DEG = tuple(float(t) for t in np.arange(0.0, 86.0, 5.0))
+
+
+def _edges():
+    """Bin edges (radians) along θ_h (quadratic), θ_d and φ_d."""
+    u = np.arange(SHAPE[0] + 1) / SHAPE[0]
+    h = u * u * (0.5 * math.pi)
+    d = np.arange(SHAPE[1] + 1) / SHAPE[1] * (0.5 * math.pi)
+    p = np.arange(SHAPE[2] + 1) / SHAPE[2] * math.pi
+    return h, d, p
+
+
+def bin_measure(h_edges, d_edges, p_edges) -> np.ndarray:
+    """Exact (ω_i, ω_o) measure (2) of the cells with the given edges, shape (H, D, P)."""
+    wh = 8.0 * math.pi * (np.cos(h_edges[:-1]) - np.cos(h_edges[1:]))
+    wd = 0.5 * (np.sin(d_edges[1:]) ** 2 - np.sin(d_edges[:-1]) ** 2)
+    wp = np.diff(p_edges)
+    return wh[:, None, None] * wd[None, :, None] * wp[None, None, :]
+
+
+@dataclass(frozen=True, eq=False)
+class Samples:
+    """Sample pairs of a fit.
+
+    Attributes
+    ----------
+    wi, wo : ndarray (N, 3)
+        Directions at the cell centres (local frame, φ_h = 0).
+    weight : ndarray (N,)
+        Measure (2) of each cell in sr² (not normalised).
+    cos_i : ndarray (N,)
+        cos θ_i.
+    """
+
+    wi: np.ndarray
+    wo: np.ndarray
+    weight: np.ndarray
+    cos_i: np.ndarray
+
+    def __len__(self) -> int:
+        return self.wi.shape[0]
+
+    def subset(self, keep) -> Samples:
+        """The samples where boolean *keep* is true."""
+        return Samples(self.wi[keep], self.wo[keep], self.weight[keep], self.cos_i[keep])
+
+
+def merl_samples(*, strides=DEFAULT_STRIDES, theta_max=None) -> Samples:
+    """The MERL-grid samples (module docstring) with both directions above the horizon.
+
+    Parameters
+    ----------
+    strides : (int, int)
+        Bins merged per cell along θ_d (a divisor of 90) and φ_d (a divisor of 180);
+        (1, 1): every bin.
+    theta_max : float or None
+        Keep only pairs with θ_i, θ_o ≤ theta_max (radians), e.g. 80° (Ngan et al. 2005).
+    """
+    sd, sp = (int(s) for s in strides)
+    if sd < 1 or SHAPE[1] % sd or sp < 1 or SHAPE[2] % sp:
+        raise ParameterError(f"strides must divide (90, 180) (theta_d, phi_d bins); got "
+                             f"{tuple(strides)}")
+    if theta_max is not None and not (0.0 < float(theta_max) <= 0.5 * math.pi):
+        raise ParameterError(f"theta_max must lie in (0, pi/2] rad; got {theta_max!r}")
+    h, d, p = _edges()
+    d_c, p_c = d[::sd], p[::sp]
+    W = bin_measure(h, d_c, p_c)
+    # the cell's centre: the centre of its middle bin (index coordinates i + ½)
+    uh = (np.arange(SHAPE[0]) + 0.5) / SHAPE[0]
+    th = uh * uh * (0.5 * math.pi)
+    td = 0.5 * (d_c[:-1] + d_c[1:])
+    pd = 0.5 * (p_c[:-1] + p_c[1:])
+    TH, TD, PD = np.meshgrid(th, td, pd, indexing="ij")
+    wi, wo = half_diff_to_directions(TH, TD, PD)
+    wi = wi.reshape(-1, 3)
+    wo = wo.reshape(-1, 3)
+    W = W.reshape(-1)
+    keep = (wi[:, 2] > 0.0) & (wo[:, 2] > 0.0)
+    if theta_max is not None:
+        c = math.cos(float(theta_max))
+        keep &= (wi[:, 2] >= c) & (wo[:, 2] >= c)
+    wi = np.ascontiguousarray(wi[keep])
+    wo = np.ascontiguousarray(wo[keep])
+    # renormalise: half_diff_to_directions is exact to rounding; the kernels' unit check
+    # allows 1e-3, so this only removes the rounding
+    wi /= np.linalg.norm(wi, axis=1, keepdims=True)
+    wo /= np.linalg.norm(wo, axis=1, keepdims=True)
+    return Samples(wi, wo, W[keep], wi[:, 2].copy())
+
+
+def albedo_nodes(theta_deg=ALBEDO_THETA_DEG, *, n_u: int = 48, n_phi: int = 24):
+    """Quadrature pairs of a(θ_i) (module docstring).
+
+    Returns ``(wi, wo, w, T)``: pairs (T·n_u·n_phi, 3) and weights w such that
+    a(θ_t) ≈ Σ_k w_k f(wi_k, wo_k) over the t-th block of n_u·n_phi pairs (w is 0
+    where ω_o is below the horizon; such pairs are given ω_o = n to stay valid).
+    """
+    theta = np.radians(np.asarray(theta_deg, dtype=np.float64))
+    u = (np.arange(n_u) + 0.5) / n_u
+    th = u * u * (0.5 * math.pi)
+    dth = math.pi * u / n_u  # dθ_h = π u du
+    ph = (np.arange(n_phi) + 0.5) / n_phi * math.pi
+    dph = 2.0 * math.pi / n_phi  # [0, π] doubled
+    TH, PH = np.meshgrid(th, ph, indexing="ij")
+    h = np.stack([np.sin(TH) * np.cos(PH), np.sin(TH) * np.sin(PH), np.cos(TH)], -1)
+    dwh = (np.sin(TH) * dth[:, None] * dph).reshape(-1)
+    h = h.reshape(-1, 3)
+    wis, wos, ws = [], [], []
+    for t in theta:
+        wi = np.array([math.sin(t), 0.0, math.cos(t)])
+        c = h @ wi
+        wo = 2.0 * c[:, None] * h - wi
+        ok = (wo[:, 2] > 0.0) & (c > 0.0)
+        w = np.where(ok, 4.0 * c * dwh * np.maximum(wo[:, 2], 0.0), 0.0)
+        wo = np.where(ok[:, None], wo, np.array([0.0, 0.0, 1.0]))
+        wo /= np.linalg.norm(wo, axis=1, keepdims=True)
+        wis.append(np.broadcast_to(wi, wo.shape))
+        wos.append(wo)
+        ws.append(w)
+    return (np.ascontiguousarray(np.concatenate(wis)), np.ascontiguousarray(np.concatenate(wos)),
+            np.concatenate(ws), theta.size)
+
+
+def albedo_from_values(f, w, n_theta: int) -> np.ndarray:
+    """a(θ_t) from values f (M, C) at :func:`albedo_nodes` pairs: shape (T, C)."""
+    f = np.where(w[:, None] > 0.0, f, 0.0)  # below-horizon nodes carry no weight
+    return (f * w[:, None]).reshape(n_theta, -1, f.shape[1]).sum(axis=1)

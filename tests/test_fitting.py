@@ -1,0 +1,143 @@
+"""brdfkit.fitting: sample measure, linear solves, synthetic recovery, the ``fit`` command.
+
+Reference values are independent of the code under test: closed-form measures of
+direction-pair domains, closed-form albedos, SciPy's bounded least squares and
+linear programming, and the parameters a synthetic target was made with.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from scipy.optimize import linprog, lsq_linear
+
+import brdfkit
+from brdfkit.cli import main
+from brdfkit.data import MeasuredBRDF, table_from_function, write_binary
+from brdfkit.errors import ParameterError
+from brdfkit.fitting import fit
+from brdfkit.fitting._linear import box_lstsq, solve_channel
+from brdfkit.fitting.samples import (
+    _edges,
+    albedo_from_values,
+    albedo_nodes,
+    bin_measure,
+    merl_samples,
+)
+
+
+def test_sample_weights_are_the_measure_of_the_pair_domain():
+    # All MERL bins: θ_h ∈ [0, π/2] (quadratic spacing), θ_d ∈ [0, π/2], φ_d ∈ [0, π).
+    # With dω_i dω_o = 4 cos θ_d dω_h dω_d this is 2π · 1 · ½ · π · 4 = 4π², the pairs with
+    # h in the upper hemisphere (half of (4π)²) folded in φ_d (half again): closed form.
+    h, d, p = _edges()
+    assert bin_measure(h, d, p).sum() == pytest.approx(4 * math.pi ** 2, rel=1e-13)
+    # Bins whose centre has both directions above the horizon: the pairs of two upper
+    # hemispheres, (2π)², folded: 2π², up to the bins the horizon cuts (< 1e-3).
+    s = merl_samples(strides=(1, 1))
+    assert s.weight.sum() == pytest.approx(2 * math.pi ** 2, rel=1e-3)
+    # merged cells keep the measure of their bins, with coarser horizon cells (< 1 %)
+    assert merl_samples().weight.sum() == pytest.approx(2 * math.pi ** 2, rel=1e-2)
+    # Ngan's 80° cut-off: both θ ≤ 80°: (2π(1 − cos 80°))², folded
+    s80 = merl_samples(strides=(1, 1), theta_max=math.radians(80))
+    ref = 0.5 * (2 * math.pi * (1 - math.cos(math.radians(80)))) ** 2
+    assert s80.weight.sum() == pytest.approx(ref, rel=1e-2)
+
+
+def test_albedo_quadrature_closed_forms():
+    wi, wo, w, T = albedo_nodes((0.0, 30.0, 60.0, 80.0))
+    # Lambertian ρ = 1: a(θ) = 1 for every θ
+    lam = brdfkit.model("modified-phong", rho_d=1.0, rho_s=0.0)
+    a = albedo_from_values(lam.eval(wi, wo)[:, None], w, T)[:, 0]
+    np.testing.assert_allclose(a, 1.0, atol=2e-3)
+    # the normalised Phong lobe (n + 2)/2π cosⁿ at normal incidence integrates to 1
+    # (∫ (n+2)/2π cosⁿθ cosθ dω = 1), a sharp one included
+    for n in (10.0, 3000.0):
+        ph = brdfkit.model("modified-phong", rho_d=0.0, rho_s=1.0, n=n)
+        a = albedo_from_values(ph.eval(wi, wo)[:, None], w, T)[:, 0]
+        assert a[0] == pytest.approx(1.0, abs=2e-3)
+
+
+def test_linear_solves_match_scipy():
+    rng = np.random.default_rng(3)
+    N = 400
+    A = np.ascontiguousarray(rng.random((N, 3)))
+    r = A @ np.array([0.2, 1.5, -0.3]) + 0.05 * rng.standard_normal(N)
+    w = rng.random(N) + 0.1
+    lo, hi = np.array([0.0, 0.0, 0.0]), np.array([1.0, 1e6, 1.0])
+    # L2 with bounds (the true third coefficient is negative: it lands on its bound)
+    got = solve_channel(A, r, w, lo, hi, False, 0, np.empty(0))
+    sw = np.sqrt(w)
+    ref = lsq_linear(A * sw[:, None], r * sw, bounds=(lo, hi), tol=1e-12).x
+    np.testing.assert_allclose(got, ref, atol=1e-8)
+    G = (A * w[:, None]).T @ A
+    np.testing.assert_allclose(box_lstsq(G, (A * w[:, None]).T @ r, lo, hi), ref, atol=1e-8)
+    # L1 with bounds, against the linear program min Σ w t, −t ≤ A p − r ≤ t
+    got = solve_channel(A, r, w, lo, hi, True, 200, np.empty(0))
+    c = np.concatenate([np.zeros(3), w])
+    A_ub = np.block([[A, -np.eye(N)], [-A, -np.eye(N)]])
+    b_ub = np.concatenate([r, -r])
+    lp = linprog(c, A_ub=A_ub, b_ub=b_ub, bounds=list(zip(lo, hi, strict=True)) + [(0, None)] * N)
+    l1 = lambda p: float(np.sum(w * np.abs(A @ p - r)))  # noqa: E731
+    assert l1(got) == pytest.approx(lp.fun, rel=1e-5)
+
+
+def test_recovers_nielsen_parameters_from_a_merl_table():
+    # A MERL table of known Nielsen parameters (a sharp lobe, s in the thousands), read
+    # back through MeasuredBRDF: the fit from the declared defaults (s = 20) must return
+    # the parameters the table was made with.
+    truth = dict(rho_d=[0.05, 0.1, 0.2], k_s=[300.0, 250.0, 200.0], s=2000.0, alpha=0.3)
+    src = brdfkit.model("nielsen", **truth)
+    target = MeasuredBRDF(table_from_function(src.eval))
+    r = fit(brdfkit.model("nielsen"), target, loss="l2")
+    assert r.success and r.status in (0, 1), r.message
+    p = r.params
+    assert p["s"] == pytest.approx(2000.0, rel=1e-2)
+    assert p["alpha"] == pytest.approx(0.3, abs=1e-2)
+    np.testing.assert_allclose(p["rho_d"], truth["rho_d"], rtol=1e-2)
+    np.testing.assert_allclose(p["k_s"], truth["k_s"], rtol=2e-2)
+    assert r.metrics["l2"] < 1e-6 * r.convergence["stages"][0]["loss_before"]
+    assert r.convergence["linear"] == ["rho_d", "k_s"]
+
+
+def run(*args):
+    return CliRunner().invoke(main, list(args))
+
+
+def test_fit_command_recovers_a_sharp_phong_lobe_and_its_json_round_trips(tmp_path):
+    # modified Phong with n = 3000 written as a MERL .binary; -p holds rho_d at its true
+    # value; the rest is fitted with the default L1 procedure from n = 20.
+    src = brdfkit.model("modified-phong", rho_d=0.1, rho_s=0.7, n=3000.0)
+    path = write_binary(tmp_path / "phong.binary", table_from_function(src.eval))
+    res = run("fit", "modified-phong", "--to", str(path), "-p", "rho_d=0.1", "--json")
+    assert res.exit_code == 0, res.output
+    d = json.loads(res.output)
+    assert set(d) >= {"model", "params", "metrics", "albedo", "convergence"}
+    assert d["params"]["rho_d"] == 0.1  # held
+    assert d["params"]["n"] == pytest.approx(3000.0, rel=1e-2)
+    np.testing.assert_allclose(d["params"]["rho_s"], 0.7, rtol=1e-2)
+    assert set(d["metrics"]) == {"l1", "l2", "ngan", "log", "perceptual"}
+    # the fitted params go straight back as -p
+    items = [f"{k}={','.join(map(str, v)) if isinstance(v, list) else v}"
+             for k, v in d["params"].items()]
+    back = brdfkit.model("modified-phong", **{k: v for k, v in d["params"].items()})
+    res = run("eval", "modified-phong", *sum((["-p", i] for i in items), []), "--wi", "30,0",
+              "--wo", "30,180", "--json")
+    assert res.exit_code == 0, res.output
+    assert back is not None
+
+
+def test_fit_rejects_bad_arguments():
+    m = brdfkit.model("modified-phong")
+    with pytest.raises(ParameterError, match="loss must be one of l1, l2, ngan, log"):
+        fit(m, m, loss="l3")
+    with pytest.raises(ParameterError, match="procedure must be one of"):
+        fit(m, m, procedure="fast")
+    with pytest.raises(ParameterError, match="target must be a brdfkit model"):
+        fit(m, "merl:nickel")
+    res = run("fit", "modified-phong", "--to", "merl:nickel", "--loss", "l3")
+    assert res.exit_code == 2
