@@ -16,17 +16,24 @@ import math
 
 import click
 
-from brdfkit.cli._common import emit_json, model_options, parse_param_items
+from brdfkit.cli import _progress
+from brdfkit.cli._common import PARAM_HELP, emit_json, parse_param_items
 from brdfkit.errors import BrdfkitError
 
 __all__ = ["fit_cmd"]
 
 
 @click.command("fit")
-@model_options
-@click.option("--to", "to", required=True, metavar="SPEC",
-              help="The material to fit: merl:NAME[@nbrdf|npf|abc|sgd], rgl:NAME, "
-                   "nielsen:NAME or a MERL .binary path.")
+@click.argument("models", nargs=-1, required=True, metavar="MODEL...")
+@click.option("-p", "--param", "param", multiple=True, metavar="NAME=VALUE",
+              help="Hold a parameter of MODEL fixed (repeatable; one MODEL only). " + PARAM_HELP)
+@click.option("--pump", type=click.Choice(["max", "controlled"]), default=None,
+              help="Fit the pumped model (its base parameters are fitted).")
+@click.option("--times", type=int, default=None, metavar="K", help="Pump K times (with --pump).")
+@click.option("--to", "to", required=True, multiple=True, metavar="SPEC",
+              help="The material(s) to fit (repeatable): merl:NAME[@nbrdf|npf|abc|sgd], "
+                   "rgl:NAME, nielsen:NAME, a MERL .binary path, or merl:all, rgl:all, "
+                   "nielsen:all (every built-in material of the source).")
 @click.option("--loss", type=click.Choice(["l1", "l2", "ngan", "log", "perceptual"]),
               default="l1", show_default=True, help="The loss minimised (docs/fitting.md).")
 @click.option("--procedure", type=click.Choice(["auto", "staged", "nielsen", "direct"]),
@@ -36,15 +43,39 @@ __all__ = ["fit_cmd"]
               help="Runs of the shape stage (first guess, defaults, random).")
 @click.option("--theta-max", "theta_max", type=click.FloatRange(0.0, 90.0, min_open=True),
               default=None, metavar="DEG", help="Keep pairs with theta_i, theta_o <= DEG.")
-@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON (one fit).")
 @click.option("--plot", "plot", default=None, metavar="FILE",
-              help="Write in-plane slices and albedo curves, measured vs fitted (.png/.svg).")
-def fit_cmd(model, param, pump, times, to, loss, procedure, seed, starts, theta_max, as_json,
-            plot):
+              help="Write in-plane slices and albedo curves, measured vs fitted (.png/.svg; "
+                   "one fit).")
+@click.option("--out", "out", default=None, metavar="FILE.csv",
+              help="Batch: every (MODEL, SPEC) fit as a row of FILE.csv, written atomically as "
+                   "each finishes; re-running resumes (finished rows are skipped).")
+@click.option("--workers", type=click.IntRange(1, 256), default=1, show_default=True,
+              help="Batch: local worker processes.")
+@click.option("--scheduler", default=None, metavar="ADDRESS",
+              help="Batch: run on this Dask distributed scheduler (tcp://host:8786) instead.")
+def fit_cmd(models, param, pump, times, to, loss, procedure, seed, starts, theta_max, as_json,
+            plot, out, workers, scheduler):
     """Fit MODEL's parameters to a measured material (-p NAME=VALUE holds a parameter).
 
     Example: brdfkit fit nielsen --to merl:nickel --json
+
+    Batch: several MODELs and/or materials, with --out FILE.csv, e.g.
+    brdfkit fit modified-phong nielsen --to merl:all --out fits.csv --workers 2
+    (--scheduler ADDRESS runs the same batch on a Dask cluster). A progress bar
+    shows on a terminal; Ctrl-C keeps every finished row; re-run to resume.
     """
+    from brdfkit.fitting.batch import expand_targets
+
+    targets = expand_targets(to)
+    if out is not None or len(models) > 1 or len(targets) > 1:
+        _batch(models, targets, param=param, pump=pump, times=times, loss=loss,
+               procedure=procedure, seed=seed, theta_max=theta_max, as_json=as_json,
+               plot=plot, out=out, workers=workers, scheduler=scheduler)
+        return
+    if workers != 1 or scheduler is not None:
+        raise BrdfkitError("--workers and --scheduler are for batches: add --out FILE.csv")
+    model, to = models[0], targets[0]
     import brdfkit.data
     from brdfkit.cli._common import build_model
     from brdfkit.figures import check_output_path, save_atomic
@@ -82,3 +113,33 @@ def fit_cmd(model, param, pump, times, to, loss, procedure, seed, starts, theta_
     fixed_args = " ".join(f"-p {k}={','.join(f'{x:.6g}' for x in v) if isinstance(v, list) else v}"
                           for k, v in d["params"].items() if v is not None)
     click.echo(f"# as a model: brdfkit eval {d['model']} {fixed_args}")
+
+
+def _batch(models, targets, *, param, pump, times, loss, procedure, seed, theta_max, as_json,
+           plot, out, workers, scheduler) -> None:
+    """``brdfkit fit MODEL... --to SPEC... --out FILE.csv``: one row per fit."""
+    from brdfkit._specs import canonical_name
+    from brdfkit.fitting.batch import Job, fit_row, run_batch
+
+    if out is None:
+        raise BrdfkitError(f"{len(models)} model(s) x {len(targets)} material(s) is a batch: "
+                           "add --out FILE.csv (each finished fit is written as it completes)")
+    if param:
+        raise BrdfkitError("-p holds parameters of one fit; a batch fits every parameter (drop "
+                           "-p, or fit one MODEL to one SPEC)")
+    if as_json or plot:
+        raise BrdfkitError("--json and --plot describe one fit; a batch writes --out FILE.csv")
+    if times is not None and pump is None:
+        raise BrdfkitError(f"--times {times} needs --pump max or --pump controlled")
+    for m in models:
+        canonical_name(m)  # an unknown model fails now, not in every row
+    options = tuple(sorted({"seed": seed, **({"pump": pump, "times": times or 1} if pump else {}),
+                            **({"theta_max_deg": theta_max} if theta_max else {})}.items()))
+    jobs = [Job(m, t, loss=loss, procedure=procedure, options=options)
+            for m in models for t in targets]
+    show = _progress.stderr_is_interactive()
+    with _progress.counter("fit", enabled=show) as progress:
+        report = run_batch(jobs, out=out, run_job=fit_row, workers=workers,
+                           scheduler=scheduler, progress=progress)
+    click.echo(f"{report.out}: {report.done} fitted now, {report.skipped} already there, "
+               f"{report.failed} failed, of {report.total} ({report.seconds:.1f} s)")
