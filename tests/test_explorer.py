@@ -217,3 +217,28 @@ def test_page_shows_a_diverging_verdict_and_bad_input(browser, server):
     assert "-5" in page.locator("#message").text_content()
     assert errors == []
     page.close()
+
+
+def test_page_fits_a_model_to_a_material(browser, server):
+    """The fit button: the first model fitted to the chosen material, with progress, and the
+    fitted model added to the page. Reference: a Lambertian fit to a Lambertian MERL table
+    of our own making gives its ρ_d back (closed form of the table, written in the test)."""
+    import tempfile
+    from pathlib import Path
+
+    from brdfkit.data.export import export_merl
+
+    path = Path(tempfile.mkdtemp()) / "lambert03.binary"
+    export_merl(brdfkit.model("lambert", rho_d=0.3), path)
+    page, errors = _open(browser, _url(server, [{"spec": str(path), "params": {}},
+                                                {"spec": "lambert", "params": {}}]))
+    assert page.locator("#fit-target").input_value() == str(path)
+    page.click("#fit-button")
+    page.wait_for_function("document.getElementById('fit-status').textContent"
+                           ".startsWith('fitted in')", timeout=120_000)
+    _wait_ready(page)
+    fitted = page.locator("#model-list .model").nth(2).locator("input[data-param='rho_d']")
+    rho = [float(x) for x in fitted.first.input_value().split(",")]
+    np.testing.assert_allclose(rho, 0.3, rtol=1e-3)
+    assert errors == []
+    page.close()

@@ -11,6 +11,8 @@ canvases: no CDN, the page works offline) and a JSON API:
 ``POST /api/views``         every view of every model for one state
 ``POST /api/verdict``       plausibility verdicts (slower; fetched after)
 ``POST /api/export/binary`` one model on the MERL grid (a ``.binary`` file)
+``POST /api/fit``           start fitting a model to a material (background)
+``GET  /api/fit/{id}``      its progress (stage, evaluations, loss) and result
 ==========================  =================================================
 
 A state is ``{"models": [{"spec", "params", "pump", "times", "visible"}],
@@ -29,9 +31,11 @@ directly (no shadow DOM).
 """
 
 import base64
+import itertools
 import json
 import math
 import tempfile
+import threading
 import time
 from collections import OrderedDict
 from importlib import resources
@@ -113,6 +117,18 @@ async def _body(request: Request):
         return json.loads(await request.body())
     except (ValueError, UnicodeDecodeError) as exc:
         raise BrdfkitError(f"the request body must be JSON (the explorer state): {exc}") from None
+
+
+def _clean(obj):
+    """JSON-safe copy: NaN and ±inf (a measured table's unmeasured bins, an undetermined
+    verdict) become null, as in the command line's JSON."""
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
 
 
 def _b64(png: bytes) -> str:
@@ -200,7 +216,7 @@ def create_app():
                 })
             except BrdfkitError as exc:
                 out.append({"spec": entry.get("spec"), "error": str(exc)})
-        return {"models": out, "ms": round(1e3 * (time.perf_counter() - t0), 1)}
+        return _clean({"models": out, "ms": round(1e3 * (time.perf_counter() - t0), 1)})
 
     @app.post("/api/verdict")
     async def verdicts(request: Request):
@@ -211,7 +227,7 @@ def create_app():
                 out.append(views.verdict(get_model(entry)))
             except BrdfkitError as exc:
                 out.append({"spec": entry.get("spec"), "error": str(exc)})
-        return {"verdicts": out}
+        return _clean({"verdicts": out})
 
     @app.post("/api/export/binary")
     async def export_binary(request: Request):
@@ -224,5 +240,51 @@ def create_app():
         name = "".join(c if c.isalnum() or c in "-_." else "_" for c in m.name) + ".binary"
         return Response(data, media_type="application/octet-stream",
                         headers={"Content-Disposition": f'attachment; filename="{name}"'})
+
+    fits: dict[int, dict] = {}
+    fit_ids = itertools.count(1)
+
+    def run_fit(job_id: int, m, target, loss: str) -> None:
+        from brdfkit.fitting import fit
+
+        job = fits[job_id]
+
+        def progress(stage, evaluations, value):
+            job.update(stage=stage, evaluations=int(evaluations), loss=float(value))
+
+        try:
+            r = fit(m, target, loss=loss, progress=progress)
+            d = r.to_dict()
+            job.update(state="done", params=d["params"], metrics=d["metrics"],
+                       message=r.message, success=r.success)
+        except BrdfkitError as exc:
+            job.update(state="error", error=str(exc))
+        except Exception as exc:  # noqa: BLE001 - reported in the page, never a traceback
+            job.update(state="error", error=f"internal error: {type(exc).__name__}: {exc}")
+        finally:
+            job["seconds"] = round(time.perf_counter() - job["t0"], 2)
+
+    @app.post("/api/fit")
+    async def start_fit(request: Request):
+        body = await _body(request)
+        if not isinstance(body, dict) or not isinstance(body.get("target"), str):
+            raise BrdfkitError("fit: give {'model': {...}, 'target': SPEC, 'loss': ...}")
+        loss = body.get("loss", "l1")
+        m = get_model(body.get("model"))
+        target = build_spec(body["target"])
+        job_id = next(fit_ids)
+        fits[job_id] = {"state": "running", "stage": "starting", "evaluations": 0,
+                        "t0": time.perf_counter(), "model": m.name, "target": target.name}
+        threading.Thread(target=run_fit, args=(job_id, m, target, loss), daemon=True).start()
+        return {"id": job_id}
+
+    @app.get("/api/fit/{job_id}")
+    def fit_status(job_id: int):
+        job = fits.get(job_id)
+        if job is None:
+            return JSONResponse({"error": f"no fit {job_id}"}, status_code=404)
+        out = {k: v for k, v in job.items() if k != "t0"}
+        out.setdefault("seconds", round(time.perf_counter() - job["t0"], 2))
+        return _clean(out)
 
     return app

@@ -158,7 +158,8 @@ def sphere(model, *, phi_l: float, ambient: float = 0.0, size: int = 256,
     # the ambient term ρ(V) to ALBEDO_TOL: a tenth of an 8-bit level at full exposure,
     # and seconds instead of minutes for a sharp measured peak
     r = render_sphere(model, phi_l=phi_l, ambient=ambient, size=size, rho_tol=ALBEDO_TOL)
-    rad = np.asarray(r.radiance, dtype=np.float64)
+    # NaN where a measured table has no value (unmeasured bins): shown black
+    rad = np.nan_to_num(np.asarray(r.radiance, dtype=np.float64), nan=0.0, posinf=0.0)
     if exposure is None:
         peak = float(np.max(rad))
         exposure = 1.0 / peak if peak > 0 else 1.0

@@ -223,7 +223,8 @@ def _free_coords(model, fixed, C):
 # --------------------------------------------------------------------------- fit
 def fit(model: BRDF, target: BRDF, *, loss: str = "l1", procedure: str = "auto",
         fixed: dict | None = None, theta_max: float | None = None, seed: int = 0,
-        n_starts: int = 3, strides=DEFAULT_STRIDES, max_evals: int = 200) -> FitResult:
+        n_starts: int = 3, strides=DEFAULT_STRIDES, max_evals: int = 200,
+        progress=None) -> FitResult:
     """Fit *model*'s parameters to *target* (see the module docstring).
 
     Parameters
@@ -249,6 +250,9 @@ def fit(model: BRDF, target: BRDF, *, loss: str = "l1", procedure: str = "auto",
     max_evals : int
         Nelder–Mead evaluations per run of a stage (per free coordinate: × its count,
         at least this).
+    progress : callable, optional
+        ``progress(stage, evaluations, loss)`` after each finished stage (the explorer's
+        and the CLI's progress display); it does not change the fit.
 
     Raises
     ------
@@ -276,13 +280,13 @@ def fit(model: BRDF, target: BRDF, *, loss: str = "l1", procedure: str = "auto",
     numba.set_num_threads(1)  # see the module docstring
     try:
         return _fit(model, target, loss, "staged" if procedure == "auto" else procedure,
-                    fixed, theta_max, seed, n_starts, strides, max_evals)
+                    fixed, theta_max, seed, n_starts, strides, max_evals, progress)
     finally:
         numba.set_num_threads(threads)
 
 
 def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strides,
-         max_evals) -> FitResult:
+         max_evals, progress=None) -> FitResult:
     t_start = time.perf_counter()
     rng = np.random.default_rng(seed)
     C = int(target.n_channels or 1)
@@ -352,6 +356,8 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         record["stages"].append({"stage": name, "parameters": params,
                                  "evaluations": prob.n_evals - n0, "loss_before": before,
                                  "loss_after": after, "hit_limit": bool(limit)})
+        if progress is not None:
+            progress(name, prob.n_evals, after)
 
     hit_limit = False
     scale = prob.loss_at(values)

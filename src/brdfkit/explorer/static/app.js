@@ -186,6 +186,7 @@ function renderModelList() {
     box.appendChild(err);
     list.appendChild(box);
   });
+  refreshFitTargets();
 }
 
 function bindGlobal(id, parse) {
@@ -458,6 +459,41 @@ async function fetchVerdicts(req) {
   }
 }
 
+function refreshFitTargets() {
+  const sel = document.getElementById("fit-target");
+  const keep = sel.value;
+  sel.innerHTML = "";
+  const specs = state.models.map(m => m.spec).filter(s => s.includes(":") || s.endsWith(".binary"));
+  for (const s of specs) { const o = document.createElement("option"); o.value = s; o.textContent = s; sel.appendChild(o); }
+  if (specs.includes(keep)) sel.value = keep;
+}
+
+async function startFit() {
+  const box = document.getElementById("fit-status");
+  const target = document.getElementById("fit-target").value;
+  const model = state.models.find(m => !(m.spec.includes(":") || m.spec.endsWith(".binary")));
+  if (!target || !model) { box.textContent = "add a material (e.g. merl:nickel) and a model to fit"; return; }
+  box.textContent = "fitting " + model.spec + " to " + target + " …";
+  try {
+    const { id } = await api("/api/fit", { model, target, loss: document.getElementById("fit-loss").value });
+    for (;;) {
+      await new Promise(r => setTimeout(r, 300));
+      const j = await api("/api/fit/" + id);
+      if (j.state === "running") {
+        box.textContent = "fitting " + j.model + " to " + j.target + ": " + j.stage + ", " +
+          j.evaluations + " evaluations, " + j.seconds + " s";
+        continue;
+      }
+      if (j.state === "error") { box.textContent = "fit failed: " + j.error; return; }
+      box.textContent = "fitted in " + j.seconds + " s: " + j.message;
+      state.models.push({ spec: model.spec, params: j.params, pump: model.pump || null,
+                          times: model.times || 1, visible: true, fitted_to: target });
+      renderModelList(); update();
+      return;
+    }
+  } catch (e) { box.textContent = "fit failed: " + e.message; }
+}
+
 function download(name, blob) {
   const a = document.createElement("a");
   a.href = URL.createObjectURL(blob); a.download = name; a.click();
@@ -476,6 +512,7 @@ async function init() {
   for (const m of catalog.models) { const o = document.createElement("option"); o.value = m.name; dl.appendChild(o); }
   for (const s of catalog.materials) { const o = document.createElement("option"); o.value = s; dl.appendChild(o); }
   renderModelList();
+  document.getElementById("fit-button").addEventListener("click", startFit);
   bindGlobal("theta_i", Number); bindGlobal("phi_i", Number); bindGlobal("phi_l", Number);
   bindGlobal("ambient", Number); bindGlobal("mode", String); bindGlobal("log", Boolean);
   bindGlobal("cosine", Boolean);
