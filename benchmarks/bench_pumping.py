@@ -21,21 +21,12 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import time
 
 import numpy as np
+from _timing import median_time
 
 import brdfkit
 from brdfkit.pumping import build_albedo_table, pump
-
-
-def _median_time(fn, repeats):
-    ts = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t)
-    return statistics.median(ts)
 
 
 def _pairs(n, rng, lobe_width=None):
@@ -63,7 +54,7 @@ def main(argv=None):
     print("1. albedo table build, modified-phong n = 5000 (rho_d = 0, rho_s = 1)")
     m5000 = brdfkit.model("modified-phong", rho_d=0.0, rho_s=1.0, n=5000.0)
     tab = build_albedo_table(m5000)  # warm-up: compiles the engine for this kernel
-    t_build = _median_time(lambda: build_albedo_table(m5000), args.repeats)
+    t_build = median_time(lambda: build_albedo_table(m5000), args.repeats)
     print(f"   {tab.n_intervals} intervals, {tab.n_evaluations} engine angles, "
           f"max midpoint error {tab.max_midpoint_error[0]:.2e}")
     print(f"   median build time {t_build * 1e3:8.1f} ms   (target <= 200 ms: "
@@ -86,7 +77,7 @@ def main(argv=None):
             times = {name: [] for name, _ in stages}
             for _ in range(args.repeats):
                 for name, m in stages:
-                    times[name].append(_median_time(lambda m=m, wi=wi, wo=wo: m.eval(wi, wo), 1))
+                    times[name].append(median_time(lambda m=m, wi=wi, wo=wo: m.eval(wi, wo), 1))
             t_base = statistics.median(times["base"])
             for name, _ in stages:
                 t = statistics.median(times[name])

@@ -19,10 +19,10 @@ from __future__ import annotations
 
 import argparse
 import math
-import statistics
 import time
 
 import numpy as np
+from _timing import median_time
 
 import brdfkit
 from brdfkit.pumping import pump
@@ -32,13 +32,6 @@ from brdfkit.render.sphere import _lit_pixels
 TARGET_512_S = 0.020
 
 
-def _median_time(fn, repeats):
-    ts = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t)
-    return statistics.median(ts)
 
 
 def _models():
@@ -73,8 +66,8 @@ def main(argv=None):
         k = _lit_pixels(S, *L, wi, wo, idx, cos_l)
         a, b = wi[:k], wo[:k]
         for name, m in models.items():
-            t_r = _median_time(lambda m=m, S=S: render_sphere(m, phi_l=phi, size=S), args.repeats)
-            t_e = _median_time(lambda m=m, a=a, b=b: m.eval(a, b), args.repeats)
+            t_r = median_time(lambda m=m, S=S: render_sphere(m, phi_l=phi, size=S), args.repeats)
+            t_e = median_time(lambda m=m, a=a, b=b: m.eval(a, b), args.repeats)
             ok = "" if S != 512 else ("met" if t_r <= TARGET_512_S else "MISSED")
             print(f"{name:24s} {S:5d} {1e3 * t_r:10.2f} {S * S / t_r / 1e6:8.1f} "
                   f"{1e3 * t_e:8.2f} {t_r / t_e:11.2f} {ok:>7s}")
@@ -84,7 +77,7 @@ def main(argv=None):
         t0 = time.perf_counter()
         r = render_sphere(m, phi_l=phi, size=512, ambient=0.5)
         first = time.perf_counter() - t0
-        later = _median_time(lambda m=m: render_sphere(m, phi_l=phi, size=512, ambient=0.5),
+        later = median_time(lambda m=m: render_sphere(m, phi_l=phi, size=512, ambient=0.5),
                              max(3, args.repeats // 3))
         nodes = r.ambient_message.split(" on ")[-1].split(" nodes")[0] if r.success else "-"
         print(f"{name:24s} {first:8.2f} {1e3 * later:9.2f} {nodes:>11s} "

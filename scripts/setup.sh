@@ -35,35 +35,33 @@ if [ ! -x .venv/bin/python ]; then
   "$py" -m venv .venv
 fi
 
-# System part: Mitsuba 3's llvm_* variants (rendering, the Mitsuba bridge and its tests) need
-# Debian's libllvm19 (LLVM 15/16 load but abort on microfacet kernels). Installed with apt when
-# running as root; otherwise brdfkit falls back to Mitsuba's scalar_* variants and says so.
-if [ -n "$extra" ] || [ "${BRDFKIT_SYSTEM_DEPS:-0}" = 1 ]; then
-  if ldconfig -p 2>/dev/null | grep -q 'libLLVM.so.19\|libLLVM-19'; then
-    :
-  elif [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-    echo "setup.sh: installing libllvm19 (apt) for Mitsuba's llvm_* variants"
-    apt-get install -y -q libllvm19 >/dev/null 2>&1 \
-      || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q libllvm19 >/dev/null; } \
-      || echo "setup.sh: warning: could not install libllvm19; Mitsuba renders fall back to scalar_* variants (slower)" >&2
-  else
-    echo "setup.sh: note: libllvm19 is missing and this is not root with apt-get; Mitsuba renders fall back to scalar_* variants (slower). Fix: sudo apt-get install libllvm19" >&2
+# system_package PKG PRESENT WHAT_FOR WITHOUT: install Debian package PKG with apt when the
+# shell test PRESENT fails and this is root with apt-get; otherwise say what is missing,
+# what WITHOUT it happens, and how to fix it.
+system_package() {
+  local pkg="$1" present="$2" purpose="$3" without="$4"
+  if eval "$present"; then
+    return 0
   fi
-fi
+  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+    echo "setup.sh: installing $pkg (apt) for $purpose"
+    apt-get install -y -q "$pkg" >/dev/null 2>&1 \
+      || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q "$pkg" >/dev/null; } \
+      || echo "setup.sh: warning: could not install $pkg; $without" >&2
+  else
+    echo "setup.sh: note: $pkg is missing and this is not root with apt-get; $without. Fix: sudo apt-get install $pkg" >&2
+  fi
+}
 
-# System part for the explorer's browser tests (--test/--dev): Debian's chromium, driven by
-# Playwright with executable_path (Playwright cannot download browsers here).
-if [ -n "$extra" ]; then
-  if command -v chromium >/dev/null 2>&1; then
-    :
-  elif [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-    echo "setup.sh: installing chromium (apt) for the explorer's browser tests"
-    apt-get install -y -q chromium >/dev/null 2>&1 \
-      || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q chromium >/dev/null; } \
-      || echo "setup.sh: warning: could not install chromium; the browser tests will be skipped (with this reason)" >&2
-  else
-    echo "setup.sh: note: chromium is missing and this is not root with apt-get; the explorer's browser tests will be skipped. Fix: sudo apt-get install chromium" >&2
-  fi
+# System parts of the test extras: Mitsuba 3's llvm_* variants (rendering, the Mitsuba bridge
+# and its tests) need Debian's libllvm19 (LLVM 15/16 load but abort on microfacet kernels);
+# the explorer's browser tests need Debian's chromium, driven by Playwright with
+# executable_path (Playwright cannot download browsers here).
+if [ -n "$extra" ] || [ "${BRDFKIT_SYSTEM_DEPS:-0}" = 1 ]; then
+  system_package libllvm19 "ldconfig -p 2>/dev/null | grep -q 'libLLVM.so.19\\|libLLVM-19'" \
+    "Mitsuba's llvm_* variants" "Mitsuba renders fall back to scalar_* variants (slower)"
+  system_package chromium "command -v chromium >/dev/null 2>&1" \
+    "the explorer's browser tests" "the browser tests are skipped, saying why"
 fi
 
 .venv/bin/python -m pip install -q --upgrade pip
