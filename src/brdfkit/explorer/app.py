@@ -23,11 +23,14 @@ A model that cannot be built (unknown spec, parameter out of bounds, unreadable 
 drawn. Models are cached by their full description (a pumped model's tables
 are built once).
 
-Why FastAPI and not Panel: measured on this machine, one ``/api/views`` round
-trip for a model is dominated by the views themselves (see
-``benchmarks/bench_explorer.py``); FastAPI adds about a millisecond, needs no
-Bokeh document model, and the page stays plain HTML that Playwright drives
-directly (no shadow DOM).
+Why FastAPI and not Panel: a slider move must redraw every view in 100 ms, and
+measured (``benchmarks/bench_explorer.py``, one analytic model) a direction move
+costs ~32 ms end to end, ~10 ms of it the views and the rest JSON encoding of the
+lobe and curves plus the HTTP layer; a parameter move 44–62 ms with the albedo
+curve. The thinnest layer that serves JSON and a static page keeps that margin;
+the page stays plain HTML/JS with no CDN (the machine is offline) that Playwright
+drives directly (Panel/Bokeh render in shadow DOM). Panel itself was not
+benchmarked here.
 """
 
 import base64

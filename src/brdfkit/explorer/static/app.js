@@ -549,6 +549,14 @@ async function init() {
       cv.toBlob(blob => download("brdfkit-" + b.dataset.for + ".png", blob));
     });
   }
+  for (const b of document.querySelectorAll("button.png-img")) {  // every image of the view
+    b.addEventListener("click", () => {
+      document.querySelectorAll("#" + b.dataset.for + " img").forEach((img, k) => {
+        const a = document.createElement("a");
+        a.href = img.src; a.download = "brdfkit-" + b.dataset.for + "-" + k + ".png"; a.click();
+      });
+    });
+  }
   const lobe = document.getElementById("lobe");
   let drag = null;
   lobe.addEventListener("mousedown", ev => { drag = [ev.clientX, ev.clientY, lobeView.yaw, lobeView.pitch]; });
