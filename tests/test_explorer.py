@@ -242,3 +242,20 @@ def test_page_fits_a_model_to_a_material(browser, server):
     np.testing.assert_allclose(rho, 0.3, rtol=1e-3)
     assert errors == []
     page.close()
+
+
+def test_explore_command_errors():
+    """`brdfkit explore`: an unknown spec or a taken port is one line, exit 2, no server."""
+    from click.testing import CliRunner
+
+    from brdfkit.cli import main
+
+    r = CliRunner().invoke(main, ["explore", "--no-browser", "nikel"])
+    assert r.exit_code == 2 and "merl:nickel" in r.output
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        port = s.getsockname()[1]
+        r = CliRunner().invoke(main, ["explore", "--no-browser", "--port", str(port)])
+    assert r.exit_code == 2 and f"cannot serve on 127.0.0.1:{port}" in r.output, r.output
+    assert r.output.count("\n") == 1

@@ -33,6 +33,20 @@ def start_url(host: str, port: int, specs=()) -> str:
     return url
 
 
+def _check_free(host: str, port: int) -> None:
+    """One clear error when the address is taken or invalid (uvicorn would log its own
+    error and exit with status 3)."""
+    import socket
+
+    try:
+        with socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET) as s:
+            s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            s.bind((host, port))
+    except OSError as exc:
+        raise BrdfkitError(f"cannot serve on {host}:{port}: {exc.strerror or exc} (try another "
+                           "--port, or stop the program using it)") from None
+
+
 def serve(*, specs=(), host: str = LOCALHOST, port: int = DEFAULT_PORT, open_browser: bool = True,
           log=print) -> None:
     """Serve until Ctrl-C. *specs* (model names or material specs) are validated first."""
@@ -45,6 +59,7 @@ def serve(*, specs=(), host: str = LOCALHOST, port: int = DEFAULT_PORT, open_bro
         raise BrdfkitError(f"--port must be an integer from 1 to 65535; got {port!r}")
     for s in specs:
         build_spec(s)  # an unknown spec fails here, with the dispatcher's did-you-mean message
+    _check_free(host, port)
     url = start_url(host, port, specs)
     where = ("this machine only" if host == LOCALHOST else
              f"every machine that can reach {host} (--host given)")
