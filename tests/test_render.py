@@ -239,7 +239,10 @@ def test_input_errors():
     m = brdfkit.model("lambert")
     for kwargs, text in [({"phi_l": 4.0}, "phi_l"), ({"phi_l": 0.1, "size": 0}, "size"),
                          ({"phi_l": 0.1, "ambient": -1}, "ambient"),
-                         ({"phi_l": 0.1, "engine": "mitsuba"}, "not available")]:
+                         ({"phi_l": 0.1, "engine": "path"}, "engine must be one of"),
+                         ({"phi_l": 0.1, "spp": 16}, "takes no samples"),
+                         ({"phi_l": 0.1, "engine": "mitsuba", "light_azimuth": 1.0},
+                          "light_azimuth")]:
         with pytest.raises(BrdfkitError, match=text):
             render_sphere(m, **kwargs)
     with pytest.raises(BrdfkitError, match="brdfkit.model"):

@@ -16,7 +16,7 @@ import math
 
 import click
 
-from brdfkit.cli import _progress
+import brdfkit.cli._progress as _progress
 from brdfkit.cli._common import PARAM_HELP, emit_json, parse_param_items
 from brdfkit.errors import BrdfkitError
 
