@@ -16,6 +16,7 @@ from types import MappingProxyType
 from brdfkit.errors import BrdfkitError
 from brdfkit.figures import lewis, lewis_spheres, neumann
 from brdfkit.figures import models as model_figures
+from brdfkit.figures import nielsen as nielsen_figures
 from brdfkit.figures import pumping as pumping_figures
 from brdfkit.figures._save import check_output_path, save_atomic
 
@@ -33,6 +34,7 @@ FIGURES: Mapping[str, Callable] = MappingProxyType({
     "lewis-fig9": lewis.lewis_fig9,
     "lewis-fig10": lewis_spheres.lewis_fig10,
     "neumann-fig1": neumann.neumann_fig1,
+    "nielsen-fig1": nielsen_figures.nielsen_fig1,
     "neumann-fig3": pumping_figures.neumann_fig3,
     "neumann-fig4": pumping_figures.neumann_fig4,
     "neumann-fig5": pumping_figures.neumann_fig5,
