@@ -17,9 +17,9 @@ views are also timed one by one (median, ms) so that the slowest is visible.
 from __future__ import annotations
 
 import argparse
-import statistics
-import time
 import warnings
+
+from _timing import median_time
 
 import brdfkit
 from brdfkit.explorer import views
@@ -33,13 +33,8 @@ TARGET_MS = 100.0
 
 
 def _median_ms(f, repeats):
-    f()
-    ts = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        f()
-        ts.append(1e3 * (time.perf_counter() - t))
-    return statistics.median(ts)
+    f()  # warm-up (compilation, caches)
+    return 1e3 * median_time(f, repeats)
 
 
 def bench_one(client, spec, params, moved, value, n):

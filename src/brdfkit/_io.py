@@ -4,19 +4,24 @@ Every file brdfkit writes (figures, MERL tables, renders, fit results) goes
 through :func:`write_atomic`: the bytes go to a temporary file in the target
 directory, which is renamed over the target with :func:`os.replace` (atomic on
 POSIX), and removed again on any error or interruption. Errors name the path
-and what is wrong with it.
+and what is wrong with it. :func:`to_jsonable` makes any result JSON-ready in
+one way for every writer of JSON (the CLI's ``--json``, the explorer's API):
+NumPy values to Python types, NaN and ±inf to null.
 """
 
 from __future__ import annotations
 
+import math
 import os
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import BinaryIO
+
+import numpy as np
 
 from brdfkit.errors import BrdfkitError
 
-__all__ = ["write_atomic", "check_output_path"]
+__all__ = ["write_atomic", "check_output_path", "to_jsonable"]
 
 
 def check_output_path(path, *, option: str = "path", suffixes: tuple[str, ...] = ()) -> str:
@@ -79,3 +84,21 @@ def write_atomic(path, write: Callable[[BinaryIO], None], *, option: str = "path
                                f"({exc.strerror or exc})") from None
         raise
     return p
+
+
+def to_jsonable(obj):
+    """Recursively convert NumPy values to JSON types; NaN and ±inf become None."""
+    if isinstance(obj, Mapping):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, list | tuple):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.bool_ | bool):
+        return bool(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, np.floating | float):
+        x = float(obj)
+        return x if math.isfinite(x) else None
+    return obj

@@ -28,6 +28,7 @@ from collections.abc import Callable, Iterable, Mapping
 import click
 import numpy as np
 
+from brdfkit._io import to_jsonable
 from brdfkit._specs import canonical_name, model_params
 from brdfkit._specs import model as build_spec
 from brdfkit.cli._group import EXIT_USAGE
@@ -257,24 +258,6 @@ def parse_direction(text: str, option: str = "--wi") -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- JSON
-def to_jsonable(obj):
-    """Recursively convert NumPy values to JSON types; NaN and ±inf become None."""
-    if isinstance(obj, Mapping):
-        return {str(k): to_jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, np.ndarray):
-        return to_jsonable(obj.tolist())
-    if isinstance(obj, list | tuple):
-        return [to_jsonable(v) for v in obj]
-    if isinstance(obj, np.bool_ | bool):
-        return bool(obj)
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, np.floating | float):
-        x = float(obj)
-        return x if math.isfinite(x) else None
-    return obj
-
-
 def emit_json(obj, *, indent: int | None = 2) -> None:
     """Print *obj* as strict JSON on stdout (see :func:`to_jsonable`)."""
     click.echo(json.dumps(to_jsonable(obj), indent=indent, allow_nan=False))

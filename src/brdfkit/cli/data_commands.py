@@ -19,21 +19,10 @@ import click
 from brdfkit._io import check_output_path
 from brdfkit.cli._common import build_model, emit_json, model_options
 from brdfkit.data import material, materials
-from brdfkit.data.catalog import MaterialInfo, normal_albedo
+from brdfkit.data.catalog import material_info, normal_albedo
 from brdfkit.data.export import export_merl
-from brdfkit.errors import BrdfkitError
 
 __all__ = ["materials_cmd", "export_cmd"]
-
-
-def _info_of(spec: str) -> MaterialInfo:
-    """The catalog entry of one spec (the dispatcher's error for an unknown one)."""
-    m = material(spec)  # raises the did-you-mean error
-    for info in materials(representations=True):
-        if info.name == m.name:
-            return info
-    raise BrdfkitError(f"{spec!r} is not a built-in material (a .binary file has no catalog "
-                       "entry); 'brdfkit materials' lists the built-in ones")
 
 
 @click.command("materials")
@@ -54,7 +43,8 @@ def materials_cmd(specs, representations, as_json):
     lobe). MERL data: Matusik et al. 2003, CC-BY-SA-4.0 — keep the
     attribution in derived work.
     """
-    rows = [_info_of(s) for s in specs] if specs else materials(representations=representations)
+    rows = ([material_info(s) for s in specs] if specs
+            else materials(representations=representations))
     if as_json:
         emit_json([r.to_dict() for r in rows])
         return

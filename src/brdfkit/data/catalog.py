@@ -29,7 +29,8 @@ closest valid names.
 Public objects
 --------------
 - :func:`material` — resolve a spec to a model.
-- :func:`materials` — the catalog: one :class:`MaterialInfo` per material.
+- :func:`materials` — the catalog: one :class:`MaterialInfo` per material;
+  :func:`material_info` — the entry of one spec.
 - :func:`material_names` — the built-in specs.
 - :func:`suggest_material_specs` — did-you-mean hints for a bare material name.
 - :func:`is_material_spec` — whether a string is a material spec (for the
@@ -69,7 +70,8 @@ from brdfkit.data.surrogates import (
 )
 from brdfkit.errors import DataFileError, UnknownModelError
 
-__all__ = ["MaterialInfo", "material", "materials", "material_names", "is_material_spec",
+__all__ = ["MaterialInfo", "material", "material_info", "materials", "material_names",
+           "is_material_spec",
            "suggest_material_specs",
            "normal_albedo", "data_file", "MATERIAL_SOURCES"]
 
@@ -343,6 +345,17 @@ def _info(spec: str) -> MaterialInfo:
     return MaterialInfo(name=m.name, source=m.source, material=m.material,
                         representation=m.representation, licence=m.licence,
                         citation=m.citation, albedo=a, rho_d=rd)
+
+
+def material_info(spec) -> MaterialInfo:
+    """The catalog entry of one built-in material spec (its albedo estimate computed for that
+    material alone). Raises UnknownModelError as :func:`material`, and for a ``.binary``
+    path, which has no catalog entry."""
+    m = material(spec)
+    if not isinstance(m, SurrogateBRDF):
+        raise UnknownModelError(f"{spec!r} is not a built-in material (a .binary file has no "
+                                "catalog entry); 'brdfkit materials' lists the built-in ones")
+    return _info(m.name)
 
 
 def materials(*, representations: bool = False) -> list[MaterialInfo]:

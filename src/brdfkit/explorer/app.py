@@ -47,6 +47,7 @@ from pathlib import Path
 from fastapi import FastAPI, Request
 from fastapi.responses import HTMLResponse, JSONResponse, Response
 
+from brdfkit._io import to_jsonable
 from brdfkit._specs import model as build_spec
 from brdfkit.data import material_names
 from brdfkit.data.export import export_merl
@@ -120,18 +121,6 @@ async def _body(request: Request):
         return json.loads(await request.body())
     except (ValueError, UnicodeDecodeError) as exc:
         raise BrdfkitError(f"the request body must be JSON (the explorer state): {exc}") from None
-
-
-def _clean(obj):
-    """JSON-safe copy: NaN and ±inf (a measured table's unmeasured bins, an undetermined
-    verdict) become null, as in the command line's JSON."""
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_clean(v) for v in obj]
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
 
 
 def _b64(png: bytes) -> str:
@@ -219,7 +208,7 @@ def create_app():
                 })
             except BrdfkitError as exc:
                 out.append({"spec": entry.get("spec"), "error": str(exc)})
-        return _clean({"models": out, "ms": round(1e3 * (time.perf_counter() - t0), 1)})
+        return to_jsonable({"models": out, "ms": round(1e3 * (time.perf_counter() - t0), 1)})
 
     @app.post("/api/verdict")
     async def verdicts(request: Request):
@@ -230,7 +219,7 @@ def create_app():
                 out.append(views.verdict(get_model(entry)))
             except BrdfkitError as exc:
                 out.append({"spec": entry.get("spec"), "error": str(exc)})
-        return _clean({"verdicts": out})
+        return to_jsonable({"verdicts": out})
 
     @app.post("/api/export/binary")
     async def export_binary(request: Request):
@@ -288,6 +277,6 @@ def create_app():
             return JSONResponse({"error": f"no fit {job_id}"}, status_code=404)
         out = {k: v for k, v in job.items() if k != "t0"}
         out.setdefault("seconds", round(time.perf_counter() - job["t0"], 2))
-        return _clean(out)
+        return to_jsonable(out)
 
     return app

@@ -281,13 +281,14 @@ def _run_dask(todo, run_job, scheduler, retries, record) -> None:
 
     client, own = _client(scheduler)
     try:
-        futures = [client.submit(_safe, run_job, j, pure=False, retries=retries,
-                                 key=f"brdfkit-fit-{'|'.join(j.key)}-{os.getpid()}-{k}")
-                   for k, j in enumerate(todo)]
+        job_of = {client.submit(_safe, run_job, j, pure=False, retries=retries,
+                                key=f"brdfkit-fit-{'|'.join(j.key)}-{os.getpid()}-{k}"): j
+                  for k, j in enumerate(todo)}
+        futures = list(job_of)
         try:
             for fut, row in as_completed(futures, with_results=True, raise_errors=False):
                 if fut.status == "error":  # e.g. KilledWorker after the allowed retries
-                    j = todo[futures.index(fut)]
+                    j = job_of[fut]
                     row = {**dict(zip(KEY_COLUMNS, j.key, strict=True)),
                            "status": STATUS_ERROR, "message": f"dask: {fut.exception()}"}
                 record(row)
