@@ -23,6 +23,7 @@ import math
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from test_cli_inputs import assert_one_line_error as one_line_error  # the CLI's error contract
 
 import brdfkit
 import brdfkit.data as bd
@@ -35,14 +36,6 @@ MERL_SCALES = (1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0)
 
 def run(*args: str):
     return CliRunner().invoke(main, [str(a) for a in args])
-
-
-def one_line_error(result, *fragments):
-    assert result.exit_code == 2, (result.exit_code, result.output)
-    err = result.stderr.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("brdfkit: error: "), result.stderr
-    for f in fragments:
-        assert f in err[0], (f, err[0])
 
 
 def _dir(theta_deg, phi_deg):
