@@ -254,7 +254,14 @@ def table2_cmd(as_json, as_md, models):
 @click.option("--compare", multiple=True, metavar="SPEC",
               help="Further models drawn next to --model, with their defaults (repeatable; up "
                    "to 3).")
-def figure_cmd(name, out, dpi, model, param, pump, times, compare):
+@click.option("--spp", type=click.IntRange(min=1, max=4096), default=None, metavar="N",
+              help="Monte-Carlo figures (neumann-fig8): samples per pixel (default 16).")
+@click.option("--size", type=click.IntRange(min=16, max=2048), default=None, metavar="S",
+              help="Monte-Carlo figures (neumann-fig8): width of each panel in pixels "
+                   "(default 320).")
+@click.option("--seed", type=click.IntRange(min=0), default=None, metavar="K",
+              help="Monte-Carlo figures (neumann-fig8): the sampler's seed (default 0).")
+def figure_cmd(name, out, dpi, model, param, pump, times, compare, spp, size, seed):
     """Reproduce a paper figure by computation and write it to FILE (PNG or SVG).
 
     NAME is one of the registered figures (e.g. lewis-fig3 ... lewis-fig10,
@@ -263,10 +270,13 @@ def figure_cmd(name, out, dpi, model, param, pump, times, compare):
     models), e.g.
     brdfkit figure slices --model merl:nickel --compare merl:nickel@abc --out n.png
 
-    Building takes seconds to a minute; when stderr is a
-    terminal a 'building ...' line shows it is working.
+    Building takes seconds to a minute (neumann-fig8, a Monte-Carlo render
+    through Mitsuba, a few minutes: --spp and --size trade time for noise
+    and resolution); when stderr is a terminal a 'building ...' line (or
+    a progress bar) shows it is working.
     """
     from brdfkit.figures import (
+        FIGURE_OPTIONS,
         MODEL_FIGURES,
         check_output_path,
         figure_names,
@@ -293,6 +303,9 @@ def figure_cmd(name, out, dpi, model, param, pump, times, compare):
                            "merl:nickel)")
     models = () if model is None else (build_model(model, param, pump=pump, times=times),
                                        *(build_model(s) for s in compare))
-    with _progress.status(f"building {key}", enabled=_progress.stderr_is_interactive()):
-        save_figure(key, out, dpi=dpi, option="--out", models=models)
+    options = {k: v for k, v in (("spp", spp), ("size", size), ("seed", seed)) if v is not None}
+    own_bar = key in FIGURE_OPTIONS  # the Monte-Carlo figures draw their own progress bar
+    with _progress.status(f"building {key}",
+                          enabled=_progress.stderr_is_interactive() and not own_bar):
+        save_figure(key, out, dpi=dpi, option="--out", models=models, options=options)
     click.echo(out)

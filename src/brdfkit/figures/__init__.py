@@ -16,7 +16,9 @@ Layout (imports go downward only)
   (``lewis-fig3``, ``lewis-fig4``, ``lewis-fig6``, ``lewis-fig10``: rendered
   spheres), :mod:`~brdfkit.figures.neumann`
   (``neumann-fig1``), :mod:`~brdfkit.figures.pumping` (``neumann-fig3`` …
-  ``neumann-fig7``) — plain figure functions; they import the library, never
+  ``neumann-fig7``), :mod:`~brdfkit.figures.neumann_fig8` (``neumann-fig8``: a
+  Monte-Carlo render through Mitsuba, options ``spp``, ``size``, ``seed``) — plain
+  figure functions; they import the library, never
   :mod:`brdfkit.figures`.
 - :mod:`~brdfkit.figures.fitting` — :func:`~brdfkit.figures.fitting.fit_figure`, the
   figure of one fit (``brdfkit fit --plot``; it takes a result, so it is not registered).
@@ -27,6 +29,7 @@ Layout (imports go downward only)
 Public objects
 --------------
 - :data:`FIGURES` — name → figure function (read-only mapping).
+- :data:`FIGURE_OPTIONS` — name → the keyword options a figure takes.
 - :func:`make_figure`, :func:`save_figure`, :func:`figure_names`,
   :func:`resolve_figure`.
 - :func:`save_atomic`, :func:`check_output_path` — for plots that are not
@@ -36,6 +39,7 @@ Public objects
 from __future__ import annotations
 
 from brdfkit.figures._registry import (
+    FIGURE_OPTIONS,
     FIGURES,
     MODEL_FIGURES,
     figure_names,
@@ -45,5 +49,5 @@ from brdfkit.figures._registry import (
 )
 from brdfkit.figures._save import check_output_path, save_atomic
 
-__all__ = ["FIGURES", "MODEL_FIGURES", "make_figure", "save_figure", "figure_names",
+__all__ = ["FIGURES", "FIGURE_OPTIONS", "MODEL_FIGURES", "make_figure", "save_figure", "figure_names",
            "resolve_figure", "save_atomic", "check_output_path"]

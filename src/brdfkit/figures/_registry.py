@@ -16,11 +16,12 @@ from types import MappingProxyType
 from brdfkit.errors import BrdfkitError
 from brdfkit.figures import lewis, lewis_spheres, neumann
 from brdfkit.figures import models as model_figures
+from brdfkit.figures import neumann_fig8 as neumann_fig8_module
 from brdfkit.figures import nielsen as nielsen_figures
 from brdfkit.figures import pumping as pumping_figures
 from brdfkit.figures._save import check_output_path, save_atomic
 
-__all__ = ["FIGURES", "MODEL_FIGURES", "figure_names", "resolve_figure", "make_figure",
+__all__ = ["FIGURES", "FIGURE_OPTIONS", "MODEL_FIGURES", "figure_names", "resolve_figure", "make_figure",
            "save_figure"]
 
 #: name → function returning a Matplotlib Figure (read-only: edit the list here).
@@ -40,6 +41,13 @@ FIGURES: Mapping[str, Callable] = MappingProxyType({
     "neumann-fig5": pumping_figures.neumann_fig5,
     "neumann-fig6": pumping_figures.neumann_fig6,
     "neumann-fig7": pumping_figures.neumann_fig7,
+    "neumann-fig8": neumann_fig8_module.neumann_fig8,
+})
+
+#: name → the keyword options a figure takes (Monte-Carlo renders: the CLI's --spp, --size,
+#: --seed); figures not listed take none.
+FIGURE_OPTIONS: Mapping[str, tuple[str, ...]] = MappingProxyType({
+    "neumann-fig8": ("spp", "size", "seed"),
 })
 
 #: name → function of the models to draw (``f(*models)`` → Figure): figures of any model or
@@ -62,9 +70,20 @@ def resolve_figure(name: str) -> str:
     return key
 
 
-def make_figure(name: str, models=()):
-    """Build the figure *name* (a Matplotlib Figure); *models* for :data:`MODEL_FIGURES`."""
+def _check_options(key: str, options: dict) -> None:
+    allowed = FIGURE_OPTIONS.get(key, ())
+    extra = sorted(set(options) - set(allowed))
+    if extra:
+        takes = (f"it takes {', '.join(allowed)}" if allowed else "it takes none")
+        raise BrdfkitError(f"figure {key} has no option {', '.join(extra)} ({takes}; figures "
+                           f"with options: {', '.join(FIGURE_OPTIONS)})")
+
+
+def make_figure(name: str, models=(), **options):
+    """Build the figure *name* (a Matplotlib Figure); *models* for :data:`MODEL_FIGURES`,
+    *options* (keyword) for the figures of :data:`FIGURE_OPTIONS`."""
     key = resolve_figure(name)
+    _check_options(key, options)
     if key in MODEL_FIGURES:
         if not models:
             raise BrdfkitError(f"figure {key} draws given models: pass at least one model "
@@ -73,21 +92,24 @@ def make_figure(name: str, models=()):
     if models:
         raise BrdfkitError(f"figure {key} reproduces a paper figure with its own models; it "
                            f"takes no model (figures that do: {', '.join(MODEL_FIGURES)})")
-    return FIGURES[key]()
+    return FIGURES[key](**options)
 
 
-def save_figure(name: str, path, *, dpi: int = 150, option: str = "path", models=()) -> str:
+def save_figure(name: str, path, *, dpi: int = 150, option: str = "path", models=(),
+                options: dict | None = None) -> str:
     """Build figure *name* and write it to *path* (.png or .svg); return *path*.
 
     The name and the path are checked before the (possibly long) computation.
     *option* is how the caller names *path* in error messages (the CLI passes
-    ``"--out"``). *models* are the models a :data:`MODEL_FIGURES` figure draws.
+    ``"--out"``). *models* are the models a :data:`MODEL_FIGURES` figure draws;
+    *options* the keyword options of a :data:`FIGURE_OPTIONS` figure.
     """
     import matplotlib.pyplot as plt
 
-    resolve_figure(name)
+    key = resolve_figure(name)
+    _check_options(key, options or {})
     check_output_path(path, option=option)
-    fig = make_figure(name, models)
+    fig = make_figure(name, models, **(options or {}))
     try:
         return save_atomic(fig, path, dpi=dpi, option=option)
     finally:
