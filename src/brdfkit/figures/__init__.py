@@ -49,5 +49,5 @@ from brdfkit.figures._registry import (
 )
 from brdfkit.figures._save import check_output_path, save_atomic
 
-__all__ = ["FIGURES", "FIGURE_OPTIONS", "MODEL_FIGURES", "make_figure", "save_figure", "figure_names",
-           "resolve_figure", "save_atomic", "check_output_path"]
+__all__ = ["FIGURES", "FIGURE_OPTIONS", "MODEL_FIGURES", "make_figure", "save_figure",
+           "figure_names", "resolve_figure", "save_atomic", "check_output_path"]

@@ -21,8 +21,8 @@ from brdfkit.figures import nielsen as nielsen_figures
 from brdfkit.figures import pumping as pumping_figures
 from brdfkit.figures._save import check_output_path, save_atomic
 
-__all__ = ["FIGURES", "FIGURE_OPTIONS", "MODEL_FIGURES", "figure_names", "resolve_figure", "make_figure",
-           "save_figure"]
+__all__ = ["FIGURES", "FIGURE_OPTIONS", "MODEL_FIGURES", "figure_names", "resolve_figure",
+           "make_figure", "save_figure"]
 
 #: name → function returning a Matplotlib Figure (read-only: edit the list here).
 FIGURES: Mapping[str, Callable] = MappingProxyType({

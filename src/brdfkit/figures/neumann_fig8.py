@@ -32,9 +32,9 @@ import brdfkit
 from brdfkit.pumping import pump
 from brdfkit.render import to_srgb8
 from brdfkit.render.metals import METALS, WAVELENGTHS, spectral_to_linear_srgb
-from brdfkit.render.tank import PACK, SKY_RADIANCE, render_tank
+from brdfkit.render.tank import PACK, SKY_RADIANCE, check_render_options, render_tank
 
-__all__ = ["neumann_fig8", "fig8_panels", "EXPONENTS", "EXPOSURE", "SPP", "SIZE"]
+__all__ = ["neumann_fig8", "fig8_panels", "draw_fig8", "EXPONENTS", "EXPOSURE", "SPP", "SIZE"]
 
 #: Phong exponents of the two columns (left, right).
 EXPONENTS = (20.0, 5000.0)
@@ -58,6 +58,7 @@ def fig8_panels(*, spp: int = SPP, size: int = SIZE, seed: int = 0,
     """
     from tqdm import tqdm
 
+    check_render_options(size=size, spp=spp, seed=seed)  # before the pumping
     n_renders = len(EXPONENTS) * 2 * -(-WAVELENGTHS.size // PACK)
     images, seconds = {}, {}
     with tqdm(total=n_renders + len(EXPONENTS), desc="neumann-fig8", unit="step",
@@ -95,9 +96,14 @@ def neumann_fig8(*, spp: int = SPP, size: int = SIZE, seed: int = 0, progress: b
     progress : bool
         Show a tqdm progress bar on stderr (when it is a terminal).
     """
+    return draw_fig8(fig8_panels(spp=spp, size=size, seed=seed, progress=progress))
+
+
+def draw_fig8(res: dict):
+    """The figure of :func:`fig8_panels`' result (one exposure for all four panels)."""
     import matplotlib.pyplot as plt
 
-    res = fig8_panels(spp=spp, size=size, seed=seed, progress=progress)
+    spp, seed = res["spp"], res["seed"]
     exposure = EXPOSURE / SKY_RADIANCE
     fig, axes = plt.subplots(2, 2, figsize=(9.0, 7.2), squeeze=False)
     for r, pumped in enumerate((False, True)):

@@ -74,6 +74,7 @@ References
 from __future__ import annotations
 
 import numpy as np
+from scipy.integrate import trapezoid
 
 from brdfkit._array import as_directions
 from brdfkit.errors import BrdfkitError, ParameterError
@@ -174,7 +175,7 @@ def cmf_weights(wavelengths=WAVELENGTHS) -> np.ndarray:
     for i, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True)):
         x = np.concatenate([[a], grid[(grid > a) & (grid < b)], [b]])
         y = np.stack([np.interp(x, grid, table[:, j]) for j in range(3)])
-        out[:, i] = np.trapezoid(y, x, axis=1)
+        out[:, i] = trapezoid(y, x, axis=1)
     return out
 
 

@@ -43,6 +43,7 @@ Public objects
 --------------
 - :func:`render_tank` — the spectral image (H, W, 8) of the scene for one Phong.
 - :func:`tank_scene` — the scene dict for given Mitsuba BSDFs.
+- :func:`check_render_options` — the checks of size, spp, seed, max_depth.
 - :data:`TANK_HALF`, :data:`WALL_HEIGHT`, :data:`WALL_THICKNESS`, :data:`PYRAMIDS`,
   :data:`POINT_LIGHTS`, :data:`SKY_RADIANCE`, :data:`CAMERA`, :data:`MAX_DEPTH`.
 """
@@ -58,8 +59,8 @@ from brdfkit.models import BRDF
 from brdfkit.render.metals import METALS, WAVELENGTHS, metal_nk, metal_phong
 from brdfkit.render.mitsuba_bridge import _mitsuba, mitsuba_bsdf, use_variant, wavefront
 
-__all__ = ["render_tank", "tank_scene", "TANK_HALF", "WALL_HEIGHT", "WALL_THICKNESS",
-           "PYRAMIDS", "POINT_LIGHTS", "SKY_RADIANCE", "CAMERA", "MAX_DEPTH", "ASPECT"]
+__all__ = ["render_tank", "tank_scene", "check_render_options", "TANK_HALF", "WALL_HEIGHT",
+           "WALL_THICKNESS", "PYRAMIDS", "POINT_LIGHTS", "SKY_RADIANCE", "CAMERA", "MAX_DEPTH", "ASPECT"]
 
 #: Half the tank's outer width (scene units); the floor's top is z = 0.
 TANK_HALF = 2.0
@@ -175,6 +176,17 @@ def tank_scene(bsdfs: dict, *, width: int, height: int, max_depth: int = MAX_DEP
     return scene
 
 
+def check_render_options(*, size, spp, seed, max_depth=MAX_DEPTH) -> None:
+    """Raise :class:`ParameterError` naming the first of *size* (16 … 2048), *spp*
+    (1 … 4096), *seed* (≥ 0), *max_depth* (2 … 64) that is not an allowed integer."""
+    for name, value, lo, hi in (("size", size, 16, 2048), ("spp", spp, 1, 4096),
+                                ("max_depth", max_depth, 2, 64)):
+        if not (isinstance(value, (int, np.integer)) and lo <= value <= hi):
+            raise ParameterError(f"{name} must be an integer in [{lo}, {hi}]; got {value!r}")
+    if not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ParameterError(f"seed must be a non-negative integer; got {seed!r}")
+
+
 def render_tank(phong: BRDF, *, size: int = 320, spp: int = 16, seed: int = 0,
                 wavelengths=WAVELENGTHS, max_depth: int = MAX_DEPTH,
                 progress: Callable[[], None] | None = None) -> np.ndarray:
@@ -206,12 +218,7 @@ def render_tank(phong: BRDF, *, size: int = 320, spp: int = 16, seed: int = 0,
     """
     if not isinstance(phong, BRDF):
         raise ParameterError(f"phong must be a brdfkit model (BRDF); got {type(phong)!r}")
-    for name, value, lo, hi in (("size", size, 16, 2048), ("spp", spp, 1, 4096),
-                                ("max_depth", max_depth, 2, 64)):
-        if not (isinstance(value, (int, np.integer)) and lo <= value <= hi):
-            raise ParameterError(f"{name} must be an integer in [{lo}, {hi}]; got {value!r}")
-    if not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ParameterError(f"seed must be a non-negative integer; got {seed!r}")
+    check_render_options(size=size, spp=spp, seed=seed, max_depth=max_depth)
     lam = np.asarray(wavelengths, dtype=np.float64)
     nk = {m: metal_nk(m, lam) for m in METALS}
     mi, _ = _mitsuba()
