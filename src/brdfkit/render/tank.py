@@ -60,7 +60,8 @@ from brdfkit.render.metals import METALS, WAVELENGTHS, metal_nk, metal_phong
 from brdfkit.render.mitsuba_bridge import _mitsuba, mitsuba_bsdf, use_variant, wavefront
 
 __all__ = ["render_tank", "tank_scene", "check_render_options", "TANK_HALF", "WALL_HEIGHT",
-           "WALL_THICKNESS", "PYRAMIDS", "POINT_LIGHTS", "SKY_RADIANCE", "CAMERA", "MAX_DEPTH", "ASPECT"]
+           "WALL_THICKNESS", "PYRAMIDS", "POINT_LIGHTS", "SKY_RADIANCE", "CAMERA", "MAX_DEPTH",
+           "ASPECT"]
 
 #: Half the tank's outer width (scene units); the floor's top is z = 0.
 TANK_HALF = 2.0
