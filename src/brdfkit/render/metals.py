@@ -48,9 +48,9 @@ Neumann eq. 6 with c = (n+2)/2π), plain or pumped (:func:`brdfkit.pumping.pump`
 Its albedo is at most max F · a_base ≤ 1. Pumping is applied to the grey Phong
 lobe, before the Fresnel factor: g = max(a(L), a(V)) (eq. 20) of the Fresnel
 weighted model would divide the metal's colour out (F ≈ F₀ near the mirror
-direction, and a ≈ F₀ a_Phong), leaving every metal white; the paper's pumped
-row keeps its golden tank, and its text treats pumping as an operation on the
-Phong model ("the Phong model pumped-up once"). Sampling and pdf are the base's
+direction, and a ≈ F₀ a_Phong), leaving every metal white, while the caption
+names a golden tank for both rows, and the text treats pumping as an operation on
+the Phong model ("the Phong model pumped-up once"). Sampling and pdf are the base's
 (F varies slowly over a lobe).
 
 Public objects
@@ -243,7 +243,12 @@ class FresnelWeightedBRDF(DerivedBRDF):
             summary=f"{base.name} times the conductor Fresnel reflectance at L.H",
             reciprocal=base.reciprocal, has_sampler=base.has_sampler,
             isotropic=base.isotropic, width_param=None, kernel=None)
+        # F is smooth in the directions: f·F has the base's kinks, and so has its albedo
         self.albedo_kinks = base.albedo_kinks
+        self.albedo_kink_mus = base.albedo_kink_mus
+
+    def albedo_kinks_nv(self, theta):
+        return self.base.albedo_kinks_nv(theta)
 
     def lobes(self):
         return self.base.lobes()
