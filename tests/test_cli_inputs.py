@@ -394,7 +394,15 @@ def test_figure_building_line_when_interactive(monkeypatch, tmp_path):
     assert r.exit_code == 0, r.stderr
     assert r.stderr.startswith("building lewis-fig5 ...") and " done (" in r.stderr
     assert r.stdout.strip() == out
-    assert written == [("lewis-fig5", out, {"dpi": 150, "option": "--out", "models": ()})]
+    assert written == [("lewis-fig5", out, {"dpi": 150, "option": "--out", "models": (),
+                                            "options": {}})]
+    # a Monte-Carlo figure gets its options and draws its own progress bar (no building line)
+    written.clear()
+    r = run("figure", "neumann-fig8", "--spp", "4", "--size", "32", "--out", out)
+    assert r.exit_code == 0, r.stderr
+    assert "building" not in r.stderr
+    assert written == [("neumann-fig8", out, {"dpi": 150, "option": "--out", "models": (),
+                                              "options": {"spp": 4, "size": 32}})]
 
 
 # --------------------------------------------------------------------------- structure

@@ -42,6 +42,11 @@ def test_cli_figure_errors(tmp_path):
     assert r.exit_code == 2 and "valid names" in r.output
     r = CliRunner().invoke(main, ["figure", "lewis-fig9", "--out", str(tmp_path / "x.pdf")])
     assert r.exit_code == 2
+    # options of the Monte-Carlo figures are refused, naming them, before any work
+    r = CliRunner().invoke(main, ["figure", "lewis-fig9", "--spp", "4", "--out",
+                                  str(tmp_path / "x.png")])
+    assert r.exit_code == 2 and "has no option spp" in r.output and "neumann-fig8" in r.output
+    assert not (tmp_path / "x.png").exists()
 
 
 def test_parse_theta():
