@@ -119,8 +119,9 @@ from brdfkit._specs import model as build_model
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models import BRDF
 from brdfkit.pumping import pump
+from brdfkit.render.mitsuba_traced import traced_class, traced_supported
 
-__all__ = ["FALLBACK", "VARIANTS", "mitsuba_bsdf", "spectral_model", "use_variant",
+__all__ = ["FALLBACK", "ROUTES", "VARIANTS", "mitsuba_bsdf", "spectral_model", "use_variant",
            "wavefront"]
 
 #: The variants the bridge supports, and the scalar variant each falls back to.
@@ -135,6 +136,7 @@ LUMINANCE = np.array([0.212671, 0.715160, 0.072169])
 _FLAGS = ("SymbolicLoops", "SymbolicCalls", "SymbolicConditionals")
 _REGISTERED: set[str] = set()
 _CLASSES: dict[str, type] = {}
+_TRACED: dict[str, type] = {}
 
 
 def _mitsuba():
@@ -184,8 +186,7 @@ def use_variant(variant: str = "llvm_ad_rgb") -> str:
         mi.set_variant(used)
         variant = used
     if variant not in _REGISTERED:
-        cls = _bsdf_class(variant)
-        mi.register_bsdf("brdfkit", lambda props: cls(props))
+        mi.register_bsdf("brdfkit", lambda props, v=variant: _plugin(props, v))
         _REGISTERED.add(variant)
     return variant
 
@@ -344,14 +345,10 @@ def _bsdf_class(variant: str) -> type:
     class BrdfkitBSDF(mi.BSDF):
         """A brdfkit model as a Mitsuba BSDF (see :mod:`brdfkit.render.mitsuba_bridge`)."""
 
-        def __init__(self, props, model: BRDF | None = None, wavelengths=None):
+        traced = False  # the wavefront route: render inside wavefront()
+
+        def __init__(self, props, model: BRDF, wavelengths=None):
             mi.BSDF.__init__(self, props)
-            if model is None:
-                model, wavelengths = _model_from_props(props)
-            if model.has_delta:
-                warnings.warn(f"brdfkit: {model.name}'s specular delta term is not rendered "
-                              "by the Mitsuba bridge (only its kernel)", RuntimeWarning,
-                              stacklevel=2)
             self.model = model
             self.colour = _ColourMap(mi, variant, model, _check_wavelengths(wavelengths, model))
             flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.DiffuseReflection
@@ -496,7 +493,37 @@ def _model_from_props(props) -> tuple[BRDF, list | None]:
     return m, wavelengths
 
 
-def mitsuba_bsdf(model: BRDF, *, wavelengths=None, variant: str | None = None):
+ROUTES = ("auto", "traced", "wavefront")
+
+
+def _make_bsdf(props, model: BRDF, wavelengths, variant: str, route: str):
+    """The traced BSDF when *route* allows and the model supports it, else the wavefront one."""
+    mi, dr = _mitsuba()
+    grid = _check_wavelengths(wavelengths, model)
+    _ColourMap(mi, variant, model, grid)  # validates channels against the variant
+    if model.has_delta:
+        warnings.warn(f"brdfkit: {model.name}'s specular delta term is not rendered "
+                      "by the Mitsuba bridge (only its kernel)", RuntimeWarning, stacklevel=3)
+    if route != "wavefront" and traced_supported(model, variant, grid):
+        if variant not in _TRACED:
+            _TRACED[variant] = traced_class(mi, dr, variant)
+        return _TRACED[variant](props, model, grid)
+    if route == "traced":
+        raise ParameterError(
+            f"route='traced' needs a model with formulas (model.formulas(); {model.name} has "
+            f"{'them' if model.formulas() is not None else 'none'}), an llvm_* variant "
+            f"(got {variant}) and grey, RGB or wavelength-grid channels; use route='auto'")
+    return _bsdf_class(variant)(props, model=model, wavelengths=wavelengths)
+
+
+def _plugin(props, variant: str):
+    """The scene-dict plugin ``{"type": "brdfkit", …}`` (route "auto")."""
+    model, wavelengths = _model_from_props(props)
+    return _make_bsdf(props, model, wavelengths, variant, "auto")
+
+
+def mitsuba_bsdf(model: BRDF, *, wavelengths=None, variant: str | None = None,
+                 route: str = "auto"):
     """*model* as a Mitsuba BSDF object of the current (or given) variant.
 
     Parameters
@@ -512,16 +539,24 @@ def mitsuba_bsdf(model: BRDF, *, wavelengths=None, variant: str | None = None):
         Switch to this variant first (:func:`use_variant`, with its fallback);
         None: the current Mitsuba variant (which must be one of
         :data:`VARIANTS`).
+    route : {"auto", "traced", "wavefront"}
+        ``auto``: the traced route when the model gives formulas and the
+        variant and channels allow it (module docstring), else the wavefront
+        route; ``traced`` insists (ParameterError otherwise); ``wavefront``
+        always calls the model's NumPy/Numba methods per wavefront.
 
     Returns
     -------
     mitsuba.BSDF
         Usable as a value in a scene dict (``"bsdf": mitsuba_bsdf(model)``),
-        in ``mi.chi2.BSDFAdapter``-style tests, or directly. Render inside
+        in ``mi.chi2.BSDFAdapter``-style tests, or directly. Its attribute
+        ``traced`` says which route it takes: False means render inside
         :func:`wavefront` in ``llvm_*`` variants.
     """
     if not isinstance(model, BRDF):
         raise ParameterError(f"model must be a brdfkit model (BRDF); got {type(model)!r}")
+    if route not in ROUTES:
+        raise ParameterError(f"route must be one of {', '.join(ROUTES)}; got {route!r}")
     mi, _ = _mitsuba()
     if variant is not None:
         variant = use_variant(variant)
@@ -532,8 +567,7 @@ def mitsuba_bsdf(model: BRDF, *, wavelengths=None, variant: str | None = None):
                 f"the current Mitsuba variant must be one of {', '.join(VARIANTS)}; it is "
                 f"{variant!r} (call brdfkit.render.mitsuba_bridge.use_variant first)")
         use_variant(variant)
-    cls = _bsdf_class(mi.variant())
-    return cls(mi.Properties("brdfkit"), model=model, wavelengths=wavelengths)
+    return _make_bsdf(mi.Properties("brdfkit"), model, wavelengths, mi.variant(), route)
 
 
 def spectral_model(name: str, wavelengths, **params) -> tuple[BRDF, np.ndarray]:
