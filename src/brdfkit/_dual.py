@@ -217,9 +217,10 @@ def drjit_version(f) -> Callable:
             ns[name] = value
         else:
             del _DRJIT[py]
+            what = type(value).__name__ if name in py.__globals__ else "a builtin"
             raise TypeError(f"formula {py.__qualname__} reads the global {name!r} "
-                            f"({type(value).__name__}), which is neither a formula, a "
-                            "primitive nor a numeric constant (see brdfkit._dual)")
+                            f"({what}), which is neither a formula, a primitive nor a "
+                            "numeric constant (see brdfkit._dual)")
     return new
 
 

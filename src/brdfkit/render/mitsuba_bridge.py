@@ -2,13 +2,23 @@
 Any brdfkit model as a Mitsuba 3 BSDF
 =====================================
 
-The formulas stay written once, in brdfkit's compiled kernels: Mitsuba calls a
-Python BSDF with whole wavefronts (arrays of every path's directions) when
-Dr.Jit's symbolic loops, calls and conditionals are switched off
-(:func:`wavefront`), and the BSDF hands those arrays to ``model.eval``,
-``model.sample`` and ``model.pdf`` as NumPy float64 arrays. Measured against
-the alternative of tracing the kernels with Dr.Jit: see
-``benchmarks/bench_render_mitsuba.py``.
+The formulas stay written once. Two routes, chosen per model (``route="auto"``):
+
+- **traced** (models whose :meth:`~brdfkit.models.BRDF.formulas` are given;
+  today ``microfacet``, GGX and Beckmann, with or without Fresnel): the
+  formula functions that Numba compiles for ``model.eval``/``sample``/``pdf``
+  (:mod:`brdfkit._dual`) are rebound to Dr.Jit and called from a Python BSDF
+  that Dr.Jit traces into Mitsuba's kernel, in its default symbolic mode
+  (:mod:`brdfkit.render.mitsuba_traced`). As fast as Mitsuba's own BSDFs.
+- **wavefront** (every other model, the ``scalar_*`` variants, and RGB
+  channels in a spectral variant): Mitsuba calls a Python BSDF with whole
+  wavefronts (arrays of every path's directions) when Dr.Jit's symbolic loops,
+  calls and conditionals are switched off (:func:`wavefront`), and the BSDF
+  hands those arrays to ``model.eval``, ``model.sample`` and ``model.pdf`` as
+  NumPy float64 arrays. Works for anything, 9-40× slower.
+
+A BSDF's ``traced`` attribute says which route it takes. The design record
+(why, the formula contract) is in ``docs/architecture.md``.
 
 Conventions (where the two libraries meet)
 ------------------------------------------
@@ -51,9 +61,12 @@ C on a ``wavelengths`` grid  error          error            interpolated at λ
   per-value upsampling (``srgb_model_fetch``) is scalar-only in Python.
 - *wavelength grid* (per-wavelength parameters, e.g. a metal's n, k): the
   model is built with C channels, channel c holding the parameters at
-  ``wavelengths[c]`` (nm, increasing); per path the bridge evaluates all C
-  channels and interpolates f_r linearly in λ at each of the path's 4
-  wavelengths (held constant outside the grid). The error is that of linear
+  ``wavelengths[c]`` (nm, increasing); per path the wavefront route evaluates
+  all C channels and interpolates f_r linearly in λ at each of the path's 4
+  wavelengths (held constant outside the grid); the traced route interpolates
+  the *parameters* (n, k) linearly at the path's wavelengths and evaluates
+  once, as Mitsuba's ``irregular`` spectra do (exact for parameters linear in
+  λ; both are linear interpolation between grid points). The error is that of linear
   interpolation of f_r(λ), h²/8·|∂²f/∂λ²| for spacing h: exact for a grey
   model, and for metals at 5-10 nm spacing far below Monte-Carlo noise (the
   n, k data themselves are tabulated at a similar spacing). The cost grows
@@ -62,17 +75,18 @@ C on a ``wavelengths`` grid  error          error            interpolated at λ
 
 Cost, and a caveat
 ------------------
-Measured (``benchmarks/bench_render_mitsuba.py``, 256² sphere, 16 spp, two runs
-on a 2-core machine at load 4-6): the wavefront mode alone makes Mitsuba's own
-``roughconductor`` 2.9-4.5× slower than its default symbolic mode, and the
-bridge's ``microfacet`` (GGX) takes 6.4-12.5× the symbolic ``roughconductor``
-(brdfkit's NumPy samplers and the array conversions on top of the mode); the
-same GGX written in Dr.Jit operations and traced into Mitsuba's kernel takes
-0.64-0.73× (and gives the bridge's image to 1e-5 from the same seeds).
-While a bridge BSDF object is alive,
-Dr.Jit's symbolic calls trace it too and fail ("remains dirty"): render scenes
-with native BSDFs inside :func:`wavefront` as well, or drop the bridge objects
-(``del`` + ``gc.collect()``) first.
+Measured (``benchmarks/bench_render_mitsuba.py``, 256² sphere, 16 spp, GGX
+α = 0.2 conductor, medians of 5 renders in one process on a 2-core machine at
+load 6-8), as ratios to Mitsuba's own symbolic ``roughconductor`` (same α, η,
+κ, spp, run): the traced ``microfacet`` 1.00× in ``llvm_ad_rgb`` and
+SPECTRAL_TRACED× in ``llvm_ad_spectral`` (16-point n, k grid); the wavefront route 9.4×
+and SPECTRAL_WAVE× (the wavefront mode alone makes ``roughconductor`` 5.1× slower). The
+images agree within Monte-Carlo noise, and the two routes give the same image to
+5e-7 from the same seeds (one sampler formula).
+While a wavefront-route BSDF object is alive, Dr.Jit's symbolic calls trace it
+too and fail ("remains dirty"): render scenes with native or traced BSDFs
+inside :func:`wavefront` as well, or drop the wavefront objects (``del`` +
+``gc.collect()``) first. Traced BSDFs render in either mode.
 
 Variants
 --------
@@ -88,9 +102,10 @@ Public objects
 - :func:`use_variant` — set a Mitsuba variant (with the fallback) and register
   the ``brdfkit`` plugin in it.
 - :func:`wavefront` — context manager: Dr.Jit's symbolic modes off (required
-  while rendering with the bridge in ``llvm_*`` variants).
+  while rendering with a wavefront-route BSDF in ``llvm_*`` variants).
 - :func:`mitsuba_bsdf` — a model object as a Mitsuba BSDF object (for a scene
-  dict: ``{"type": "sphere", "bsdf": mitsuba_bsdf(model)}``).
+  dict: ``{"type": "sphere", "bsdf": mitsuba_bsdf(model)}``), by the traced
+  route where possible (``route=`` to choose).
 - :func:`spectral_model` — a model with per-wavelength parameters on a grid.
 - The scene-dict plugin ``{"type": "brdfkit", "model": SPEC, PARAM: VALUE,
   …}``: ``SPEC`` a model name or material spec (``brdfkit.model(spec,
