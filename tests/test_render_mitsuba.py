@@ -22,6 +22,11 @@ References, each independent of the code under test:
   (sRGB's white point is D65; measured in Mitsuba 3.9.1: 1 ± 2e-4 per channel).
 - **Sampling**: Mitsuba's own χ² harness (``mitsuba.chi2.ChiSquareTest``) on the
   plugin's ``sample``/``pdf``.
+- **Traced route** (``microfacet``'s formulas rebound to Dr.Jit): pointwise against
+  Mitsuba's ``roughconductor`` ``eval`` (GGX: the same Walter et al. 2007 formulas, an
+  external implementation) and against the Numba compilation of the same formulas
+  (two compilers, one code: equal to float32 rounding); the image tests above
+  (``roughconductor`` comparisons, RGB and spectral) take this route.
 
 Noise model (all image comparisons): K independent renders (different seeds) of spp
 samples per pixel; each pixel's K values are i.i.d. around the pixel's expectation, and
@@ -592,4 +597,15 @@ def test_traced_microfacet_against_roughconductor_and_numba():
     b = np.array(theirs.eval(ctx, si, wo))
     np.testing.assert_allclose(a, b, rtol=1e-4, atol=1e-6 * b.max())
     del ours
+
+    # mono: the Rec. 709 luminance (0.212671, 0.715160, 0.072169) of the RGB f_r cos θ_L
+    mono = _variant("llvm_ad_mono")
+    if not mono.startswith("scalar"):
+        ours = mitsuba_bsdf(model)
+        assert ours.traced
+        got = np.array(ours.eval(ctx, _interaction(view),
+                                 mi.Vector3f(light.T.astype(np.float32)))).reshape(-1)
+        want = model.eval(light, view) @ np.array([0.212671, 0.715160, 0.072169]) * light[:, 2]
+        np.testing.assert_allclose(got, want, rtol=1e-4, atol=1e-6 * want.max())
+        del ours
     gc.collect()

@@ -6,7 +6,10 @@ Free functions of the cosine of the angle between the incident direction and
 the (micro)surface normal, used by the models the way the papers write them.
 Each exists twice from one source: a scalar ``@njit`` function (prefix ``_``)
 that model kernels call, and a NumPy ufunc compiled from the same Python
-source for the public API. Arguments broadcast.
+source for the public API. Arguments broadcast. The conductor reflectance is
+also a formula of :mod:`brdfkit._dual` (selects only, names such as ``sqrt``
+instead of ``math.sqrt``), so the Mitsuba bridge traces the same code with
+Dr.Jit.
 
 Public objects
 --------------

@@ -21,6 +21,11 @@ GGX / Trowbridge-Reitz (Walter eqs. 33-35; Lewis's D₃)
     :func:`d_ggx`, :func:`d_ggx_of_h` (from the half-vector components, no
     cancellation for tiny α), :func:`smith_g1_ggx`, :func:`ggx_g1_over_cos`,
     :func:`ggx_lambda`, :class:`GGX`.
+Formulas (:mod:`brdfkit._dual`: compiled by Numba, traced by Dr.Jit in the Mitsuba bridge)
+    :func:`d_ggx_of_h`, :func:`ggx_g1_over_cos`, :func:`beckmann_dg_over_cos`,
+    :func:`d_of_h` and :func:`sample_half` (the D cos θ_h sampler of both
+    distributions and its D); the Beckmann h(a) is a primitive (table for
+    Numba, ``erf`` for Dr.Jit).
 Phong lobe (Lewis's D₁, a sampling proposal)
     :class:`~brdfkit.models.sampling.PowerHalf` (the "phong" distribution).
 
