@@ -76,13 +76,15 @@ C on a ``wavelengths`` grid  error          error            interpolated at λ
 Cost, and a caveat
 ------------------
 Measured (``benchmarks/bench_render_mitsuba.py``, 256² sphere, 16 spp, GGX
-α = 0.2 conductor, medians of 5 renders in one process on a 2-core machine at
-load 6-8), as ratios to Mitsuba's own symbolic ``roughconductor`` (same α, η,
-κ, spp, run): the traced ``microfacet`` 1.00× in ``llvm_ad_rgb`` and
-SPECTRAL_TRACED× in ``llvm_ad_spectral`` (16-point n, k grid); the wavefront route 9.4×
-and SPECTRAL_WAVE× (the wavefront mode alone makes ``roughconductor`` 5.1× slower). The
-images agree within Monte-Carlo noise, and the two routes give the same image to
-5e-7 from the same seeds (one sampler formula).
+α = 0.2 conductor, medians of 5 renders in one process, two runs on a 2-core
+machine at load 5-9), as ratios to Mitsuba's own symbolic ``roughconductor``
+(same α, η, κ, spp, run): the traced ``microfacet`` 1.00-1.07× in
+``llvm_ad_rgb`` and 0.45-0.59× in ``llvm_ad_spectral`` (n, k on a 16-point
+grid; ``roughconductor`` reads them as ``irregular`` spectra); the wavefront
+route 7.8-9.4× and 3.5-3.9× (the wavefront mode alone makes
+``roughconductor`` 2.5-5.1× slower). The images agree within Monte-Carlo
+noise, and the two routes give the same image to 5e-7 from the same seeds
+(one sampler formula).
 While a wavefront-route BSDF object is alive, Dr.Jit's symbolic calls trace it
 too and fail ("remains dirty"): render scenes with native or traced BSDFs
 inside :func:`wavefront` as well, or drop the wavefront objects (``del`` +
