@@ -15,7 +15,8 @@ The formulas stay written once. Two routes, chosen per model (``route="auto"``):
   wavefronts (arrays of every path's directions) when Dr.Jit's symbolic loops,
   calls and conditionals are switched off (:func:`wavefront`), and the BSDF
   hands those arrays to ``model.eval``, ``model.sample`` and ``model.pdf`` as
-  NumPy float64 arrays. Works for anything, 9-40× slower.
+  NumPy float64 arrays. Works for anything; 8-9× the time of Mitsuba's
+  own BSDF at 256², 16 spp (see *Cost* below).
 
 A BSDF's ``traced`` attribute says which route it takes. The design record
 (why, the formula contract) is in ``docs/architecture.md``.
@@ -66,8 +67,8 @@ C on a ``wavelengths`` grid  error          error            interpolated at λ
   wavelengths (held constant outside the grid); the traced route interpolates
   the *parameters* (n, k) linearly at the path's wavelengths and evaluates
   once, as Mitsuba's ``irregular`` spectra do (exact for parameters linear in
-  λ; both are linear interpolation between grid points). The error is that of linear
-  interpolation of f_r(λ), h²/8·|∂²f/∂λ²| for spacing h: exact for a grey
+  λ). Both are exact at the grid points; between them the error is that of
+  linear interpolation, h²/8·|∂²f/∂λ²| (of f_r, or of n, k) for spacing h: exact for a grey
   model, and for metals at 5-10 nm spacing far below Monte-Carlo noise (the
   n, k data themselves are tabulated at a similar spacing). The cost grows
   with C (all channels evaluated per path): keep grids to tens of points.
