@@ -19,7 +19,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "brdfkit"
 #: docs/architecture.md, "Layers"
 LAYER = {
     "errors": 0, "_array": 0, "_kern": 0, "geometry": 0, "fresnel": 0, "halfangle": 0,
-    "tables": 0, "_io": 0,
+    "tables": 0, "_io": 0, "_dual": 0,
     # the package root is the public facade (brdfkit.model resolves model names and
     # material specs): layer 2, so the data layer is below it and cli/figures above
     "": 2, "_specs": 2, "models": 1,
@@ -31,7 +31,7 @@ MAX_LINES = 850
 #: hooks of the model protocol that must be read as declared attributes, never probed
 HOOKS = {"isotropic", "specular_albedo", "albedo_kinks", "albedo_kinks_nv", "albedo_kink_mus",
          "has_delta", "has_sampler", "lobes", "sharpest_lobe", "kernel", "packed", "n_channels",
-         "reciprocal", "sample", "pdf", "to_dict"}
+         "reciprocal", "sample", "pdf", "to_dict", "formulas"}
 
 
 def _modules():

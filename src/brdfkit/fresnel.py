@@ -6,7 +6,10 @@ Free functions of the cosine of the angle between the incident direction and
 the (micro)surface normal, used by the models the way the papers write them.
 Each exists twice from one source: a scalar ``@njit`` function (prefix ``_``)
 that model kernels call, and a NumPy ufunc compiled from the same Python
-source for the public API. Arguments broadcast.
+source for the public API. Arguments broadcast. The conductor reflectance is
+also a formula of :mod:`brdfkit._dual` (selects only, names such as ``sqrt``
+instead of ``math.sqrt``), so the Mitsuba bridge traces the same code with
+Dr.Jit.
 
 Public objects
 --------------
@@ -35,6 +38,8 @@ import math
 import numba
 import numpy as np
 
+from brdfkit._dual import absolute, formula, maximum, minimum, select, sqrt
+
 __all__ = ["fresnel_dielectric", "fresnel_conductor", "fresnel_schlick", "f0_from_eta"]
 
 
@@ -54,6 +59,9 @@ def _fresnel_dielectric_py(c: float, eta: float) -> float:
     return 0.5 * (gmc * gmc) / (gpc * gpc) * (1.0 + (a * a) / (b * b))
 
 
+TINY = 5e-324  # the smallest positive float64, a divisor floor of _fresnel_conductor_py
+
+
 def _fresnel_conductor_py(c: float, eta: float, k: float) -> float:
     # Real arithmetic, exact for every η > 0, κ ≥ 0 (no complex division: the complex form
     # divided by n² and overflowed to a 0/0 for η ≲ 1e-154). With n = η + iκ, write
@@ -63,19 +71,23 @@ def _fresnel_conductor_py(c: float, eta: float, k: float) -> float:
     # (pbrt-v3's FrConductor expanded into sums of squares, so that nothing cancels:
     # F ≈ 2.5e-9 at η = 1.0001 keeps its relative accuracy). a² + b² = A = |n² − s²| and
     # a² − b² = t₀ = η² − κ² − s²; the smaller of a², b² is formed as 2η²κ²/(A ± t₀) instead
-    # of (A ∓ t₀)/2, which would cancel for small κ. Branch-free (selects), so that it
-    # vectorises inside the compiled kernels.
-    c = min(max(c, 0.0), 1.0)  # clamp: a cosine of unit vectors, see above
+    # of (A ∓ t₀)/2, which would cancel for small κ. A formula (brdfkit._dual): selects
+    # only, so that it vectorises inside the compiled kernels and Dr.Jit can trace it.
+    c = minimum(maximum(c, 0.0), 1.0)  # clamp: a cosine of unit vectors, see above
     s2 = (1.0 - c) * (1.0 + c)  # sin²θ, accurate also near c = 1
     e2 = eta * eta
     ek2 = e2 * (k * k)
     t0 = e2 - k * k - s2
-    big = math.sqrt(t0 * t0 + 4.0 * ek2)  # A
-    # A + |t₀| is 0 only when t₀ = 0 = ηκ: then a = b = 0 (the max avoids 0/0 there)
-    apt = max(big + abs(t0), 1e-300)
-    a2 = 0.5 * apt if t0 >= 0.0 else 2.0 * ek2 / apt
-    b2 = 2.0 * ek2 / apt if t0 >= 0.0 else 0.5 * apt
-    a = math.sqrt(a2)
+    big = sqrt(t0 * t0 + 4.0 * ek2)  # A
+    # A + |t₀| is 0 only when t₀ = 0 = ηκ: then a = b = 0. The floor TINY (not a select of
+    # the divisor, which LLVM turns back into a 0/0 that raises NumPy's "invalid" flag)
+    # keeps that lane 0/TINY = 0; the select covers float32, where TINY rounds to 0.
+    apt = big + absolute(t0)
+    small2 = select(apt > 0.0, 2.0 * ek2 / maximum(apt, TINY), 0.0)
+    pos = t0 >= 0.0
+    a2 = select(pos, 0.5 * apt, small2)
+    b2 = select(pos, small2, 0.5 * apt)
+    a = sqrt(a2)
     num_s = (c - a) * (c - a) + b2
     den_s = (c + a) * (c + a) + b2
     ac = a * c
@@ -83,8 +95,8 @@ def _fresnel_conductor_py(c: float, eta: float, k: float) -> float:
     den_p = (ac + s2) * (ac + s2) + b2 * (c * c)
     # a denominator is 0 only with a = b = 0 (η and κ below ~1e-154, their squares 0):
     # R_s = 1 at c = 0 (grazing) and R_p = R_s at c = 1 (normal incidence), the limits
-    rs = num_s / den_s if den_s > 0.0 else 1.0
-    ratio_p = num_p / den_p if den_p > 0.0 else 1.0
+    rs = select(den_s > 0.0, num_s / maximum(den_s, TINY), 1.0)  # floor: as apt above
+    ratio_p = select(den_p > 0.0, num_p / maximum(den_p, TINY), 1.0)
     return 0.5 * rs * (1.0 + ratio_p)
 
 
@@ -97,7 +109,7 @@ def _fresnel_schlick_py(c: float, f0: float) -> float:
 
 # Scalar kernels for model code (inlined into the compiled model kernels).
 _fresnel_dielectric = numba.njit(cache=True, inline="always")(_fresnel_dielectric_py)
-_fresnel_conductor = numba.njit(cache=True, inline="always")(_fresnel_conductor_py)
+_fresnel_conductor = formula(_fresnel_conductor_py)  # Numba; Dr.Jit: _dual.drjit_version
 _fresnel_schlick = numba.njit(cache=True, inline="always")(_fresnel_schlick_py)
 
 _ufunc_dielectric = numba.vectorize(["float64(float64, float64)"], cache=True)(

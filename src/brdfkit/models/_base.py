@@ -46,6 +46,7 @@ import numba
 import numpy as np
 
 from brdfkit._array import as_directions, as_uniform
+from brdfkit._dual import Formulas
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models.sampling import COSINE
 
@@ -425,6 +426,8 @@ class BRDF:
     - :attr:`has_delta`, :meth:`specular_albedo` — a specular delta term that
       is not in the kernel.
     - :attr:`reciprocal`, :attr:`has_sampler`, :meth:`sample`, :meth:`pdf`.
+    - :meth:`formulas` — f_r, sampler and pdf as formulas Dr.Jit can trace
+      (:class:`brdfkit._dual.Formulas`), or None (the default).
 
     Models built from other models (pumped, measured, fitted, wrapped) derive
     from :class:`DerivedBRDF`, which passes through the same set-up.
@@ -730,6 +733,11 @@ class BRDF:
         wi = COSINE.sample(wo, u)
         wi = np.broadcast_to(wi, np.broadcast_shapes(wi.shape, wo.shape)).copy()
         return wi, self.pdf(wi, wo)
+
+    def formulas(self) -> Formulas | None:
+        """eval, sample and pdf as formulas of :mod:`brdfkit._dual` (the Mitsuba bridge traces
+        them), or None: the bridge then calls :meth:`eval`/:meth:`sample`/:meth:`pdf`."""
+        return None
 
     def pdf(self, wi, wo) -> np.ndarray:
         """Solid-angle density of :meth:`sample` for wi given wo."""

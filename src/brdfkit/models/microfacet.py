@@ -33,6 +33,8 @@ import math
 import numba
 import numpy as np
 
+from brdfkit._array import as_directions, as_uniform
+from brdfkit._dual import Formulas, absolute, formula, maximum, select, sqrt
 from brdfkit._kern import INV_PI, SMALL_LENGTH, below_horizon, half, pos_pow
 from brdfkit.errors import ParameterError
 from brdfkit.fresnel import _fresnel_conductor, _fresnel_dielectric
@@ -62,14 +64,15 @@ from brdfkit.models.microfacet_distributions import (  # noqa: F401 - re-exporte
     d_beckmann,
     d_ggx,
     d_ggx_of_h,
+    d_of_h,
     distribution,
     ggx_g1_over_cos,
     ggx_lambda,
+    sample_half,
     smith_g1_beckmann,
     smith_g1_beckmann_exact,
     smith_g1_ggx,
 )
-from brdfkit.models.sampling import HalfVector, StrategySampled
 
 _jit = numba.njit(cache=True, inline="always")
 BECKMANN, GGX = 0, 1  # the packed index of the distribution choice
@@ -78,21 +81,27 @@ _FAST = VECTOR_OPTIONS["fastmath"]
 
 
 # =========================================================================== Walter 2007
-_TWO_600 = 2.0 ** 600  # the exact rescaling of a short s = wi + wo (see _walter)
+_TWO_600 = 2.0 ** 600  # the exact rescaling of a short s = wi + wo (see walter)
 _TWO_M600 = 2.0 ** -600
+INF = math.inf
 
 
-@_jit
-def _walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
+@formula
+def walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
     """F D G₁(ω_i) G₁(ω_o)/(4 cos θ_i cos θ_o), Walter eq. (20): one basic block.
 
-    Branch-free and total (see :mod:`brdfkit._kern`), so that the driver
-    vectorises it; *ggx* and *fresnel* are compile-time constants of the four
-    kernels below. Written with s = wi + wo: tan²θ_h = |s_xy|²/s_z², cos²θ_h =
-    s_z²/|s|² and ω_i·h = ω_o·h = |s|/2 (unit vectors). When every component of s
-    is below SMALL_LENGTH (both directions within 1e-140 of the horizon) their
-    squares underflow: s is first multiplied by 2^600 (a select; exact; in the
-    common case the factor is exactly 1).
+    A formula (:mod:`brdfkit._dual`): the compiled kernels below and the
+    Mitsuba bridge's traced BSDF are this one function. Branch-free and total
+    (see :mod:`brdfkit._kern`), so that the driver vectorises it; *ggx* and
+    *fresnel* are compile-time constants of the four kernels below; *p* is the
+    packed row (distribution, α, η, κ, scale) — a float64 array here, a tuple of
+    Dr.Jit values (η, κ, scale may be colours or spectra) in the bridge.
+
+    Written with s = wi + wo: tan²θ_h = |s_xy|²/s_z², cos²θ_h = s_z²/|s|² and
+    ω_i·h = ω_o·h = |s|/2 (unit vectors). When every component of s is below
+    SMALL_LENGTH (both directions within 1e-140 of the horizon) their squares
+    underflow: s is first multiplied by 2^600 (a select; exact; in the common case
+    the factor is exactly 1).
     """
     alpha, eta, k, scale = p[1], p[2], p[3], p[4]  # all parameters read first (vectorises)
     inv_a2 = 1.0 / (alpha * alpha)
@@ -104,7 +113,7 @@ def _walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
     # scale s by 2^600 when short (exact: a power of two): s_z ≥ 5e-324 then becomes
     # ≥ 2e-143, whose square is a normal number; SMALL_LENGTH·2^600 ≈ 4e40 cannot
     # overflow when squared. (1/max|s_k| would overflow for a subnormal s.)
-    r = _TWO_600 if small else 1.0  # exact 1 on the common path (no rounding added)
+    r = select(small, _TWO_600, 1.0)  # exact 1 on the common path (no rounding added)
     sx *= r
     sy *= r
     sz *= r
@@ -112,8 +121,8 @@ def _walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
     sz2 = sz * sz
     l2 = sxy2 + sz2
     if fresnel:
-        cos_d = 0.5 * math.sqrt(l2) * (_TWO_M600 if small else 1.0)  # ω_i·h = |s|/2
-        f = _fresnel_conductor(cos_d if live else 1.0, eta, k)  # 1.0: keep discarded lanes finite
+        cos_d = 0.5 * sqrt(l2) * select(small, _TWO_M600, 1.0)  # ω_i·h = |s|/2
+        f = _fresnel_conductor(select(live, cos_d, 1.0), eta, k)  # 1.0: discarded lanes finite
     else:
         f = 1.0
     if ggx:
@@ -122,30 +131,30 @@ def _walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
         # G₁/cos per direction (ggx_g1_over_cos): no 0/0 at grazing angles
         g = ggx_g1_over_cos(iz, alpha) * ggx_g1_over_cos(oz, alpha)
         v = d * g * 0.25
-        live = live & (v < math.inf)  # 1/α² = inf (α < 1e-154) off the mirror: D = 0
+        live = live & (v < INF)  # 1/α² = inf (α < 1e-154) off the mirror: D = 0
     else:
         v = beckmann_dg_over_cos(iz, oz, sxy2, sz2, alpha, inv_a2, live)
-    return scale * f * v if live else 0.0
+    return select(live, scale * f * v, 0.0)
 
 
-@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+@formula(**VECTOR_OPTIONS)
 def _walter_beckmann(ix, iy, iz, ox, oy, oz, p):
-    return _walter(ix, iy, iz, ox, oy, oz, p, False, False)
+    return walter(ix, iy, iz, ox, oy, oz, p, False, False)
 
 
-@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+@formula(**VECTOR_OPTIONS)
 def _walter_beckmann_f(ix, iy, iz, ox, oy, oz, p):
-    return _walter(ix, iy, iz, ox, oy, oz, p, False, True)
+    return walter(ix, iy, iz, ox, oy, oz, p, False, True)
 
 
-@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+@formula(**VECTOR_OPTIONS)
 def _walter_ggx(ix, iy, iz, ox, oy, oz, p):
-    return _walter(ix, iy, iz, ox, oy, oz, p, True, False)
+    return walter(ix, iy, iz, ox, oy, oz, p, True, False)
 
 
-@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+@formula(**VECTOR_OPTIONS)
 def _walter_ggx_f(ix, iy, iz, ox, oy, oz, p):
-    return _walter(ix, iy, iz, ox, oy, oz, p, True, True)
+    return walter(ix, iy, iz, ox, oy, oz, p, True, True)
 
 
 @numba.njit(cache=True, **VECTOR_OPTIONS)
@@ -170,8 +179,90 @@ _WALTER_DRIVERS = {
 }
 
 
+@formula
+def walter_sample(ox, oy, oz, u0, u1, alpha, ggx):
+    """ω_i = 2(ω_o·h)h − ω_o, h drawn from D(h) cos θ_h (Walter eqs. 28, 35), a formula.
+
+    Below the horizon when ω_o·h < 0 (the pdf is then 0: see :func:`walter_pdf`).
+    """
+    hx, hy, hz = sample_half(u0, u1, alpha, ggx)
+    c = 2.0 * (ox * hx + oy * hy + oz * hz)
+    return c * hx - ox, c * hy - oy, c * hz - oz
+
+
+@formula
+def walter_pdf(ix, iy, iz, ox, oy, oz, alpha, ggx):
+    """Solid-angle density of :func:`walter_sample`: D(h) cos θ_h/(4 |ω_o·h|), a formula.
+
+    h = (ω_i + ω_o)/|ω_i + ω_o| as it is (not folded to the upper hemisphere: a
+    direction reached with ω_o·h < 0 has density 0, Walter eq. 14's Jacobian);
+    0 when ω_o is at or below the horizon or ω_i = −ω_o.
+    """
+    hx = ix + ox
+    hy = iy + oy
+    hz = iz + oz
+    norm = sqrt(hx * hx + hy * hy + hz * hz)
+    ok = norm > 0.0
+    n = select(ok, norm, 1.0)  # 1: keep the discarded lane finite
+    hx = hx / n
+    hy = hy / n
+    hz = hz / n
+    cos_oh = absolute(ox * hx + oy * hy + oz * hz)
+    ok = ok & (cos_oh > 0.0) & (oz > 0.0)
+    p = d_of_h(hx, hy, hz, alpha, ggx) * maximum(hz, 0.0) / (4.0 * select(ok, cos_oh, 1.0))
+    return select(ok, p, 0.0)
+
+
+# the sampler and its pdf per distribution (ggx a constant), for Formulas
+@formula
+def _sample_ggx(ox, oy, oz, u0, u1, alpha):
+    return walter_sample(ox, oy, oz, u0, u1, alpha, True)
+
+
+@formula
+def _sample_beckmann(ox, oy, oz, u0, u1, alpha):
+    return walter_sample(ox, oy, oz, u0, u1, alpha, False)
+
+
+@formula
+def _pdf_ggx(ix, iy, iz, ox, oy, oz, alpha):
+    return walter_pdf(ix, iy, iz, ox, oy, oz, alpha, True)
+
+
+@formula
+def _pdf_beckmann(ix, iy, iz, ox, oy, oz, alpha):
+    return walter_pdf(ix, iy, iz, ox, oy, oz, alpha, False)
+
+
+_WALTER_KERNELS = {(False, False): _walter_beckmann, (False, True): _walter_beckmann_f,
+                   (True, False): _walter_ggx, (True, True): _walter_ggx_f}
+
+
+@numba.njit(cache=True, **VECTOR_OPTIONS)
+def _sample_rows(wo, u, alpha, ggx, wi, pdf):  # pragma: no cover - compiled
+    """walter_sample and walter_pdf over rows: wo (M, 3), u (M, 2) → wi (M, 3), pdf (M,)."""
+    for j in range(wo.shape[0]):
+        ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
+        x, y, z = walter_sample(ox, oy, oz, u[j, 0], u[j, 1], alpha, ggx)
+        wi[j, 0] = x
+        wi[j, 1] = y
+        wi[j, 2] = z
+        pdf[j] = walter_pdf(x, y, z, ox, oy, oz, alpha, ggx)
+
+
+@numba.njit(cache=True, **VECTOR_OPTIONS)
+def _pdf_rows(wi, wo, alpha, ggx, pdf):  # pragma: no cover - compiled
+    for j in range(wi.shape[0]):
+        pdf[j] = walter_pdf(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2],
+                            alpha, ggx)
+
+
+def _rows(a: np.ndarray, shape: tuple, k: int) -> np.ndarray:
+    return np.ascontiguousarray(np.broadcast_to(a, shape + (k,)).reshape(-1, k))
+
+
 @register
-class Microfacet(StrategySampled, BRDF):
+class Microfacet(BRDF):
     """Rough conductor / dielectric reflection of Walter et al. (2007), eq. (20).
 
     f_r = F(ω_i·h) D(h) G₁(ω_i) G₁(ω_o) / (4 cos θ_i cos θ_o), separable Smith
@@ -197,6 +288,10 @@ class Microfacet(StrategySampled, BRDF):
     Reciprocal. Energy: bounded by 1 with F ≤ 1 (only single scattering, so
     rough surfaces lose energy). Sampled by the distribution of normals
     D(h) cos θ_h (Walter eqs. 28, 35), pdf D cos θ_h / (4 |ω_o·h|).
+
+    f_r, the sampler and its pdf are formulas (:mod:`brdfkit._dual`:
+    :func:`walter`, :func:`walter_sample`, :func:`walter_pdf`), compiled by
+    Numba here and traced by Dr.Jit in the Mitsuba bridge.
     """
 
     name = "microfacet"
@@ -257,13 +352,35 @@ class Microfacet(StrategySampled, BRDF):
     def lobes(self):
         return [Lobe("half", float(self._values["alpha"]))]
 
-    def _distribution(self):
-        """The NumPy distribution object (D, sampling, pdf) of this instance."""
-        return distribution(self._values["distribution"], self._values["alpha"])
+    def formulas(self) -> Formulas:
+        """:func:`walter` (this instance's distribution and Fresnel) and its sampler."""
+        v = self._values
+        ggx = v["distribution"] == "ggx"
+        return Formulas(eval=_WALTER_KERNELS[(ggx, v["eta"] is not None)],
+                        sample=_sample_ggx if ggx else _sample_beckmann,
+                        pdf=_pdf_ggx if ggx else _pdf_beckmann, args=(float(v["alpha"]),))
 
-    def _strategy(self, wo):
-        """Half vectors from D cos θ_h (Walter eqs. 28, 35), pdf D cos θ_h/(4|ω_o·h|)."""
-        return HalfVector(self._distribution(), fold=False)
+    def sample(self, wo, u):
+        """Draw wi given wo from *u* ∈ [0, 1]² (..., 2) (:func:`walter_sample`); ``(wi, pdf)``."""
+        wo = as_directions(wo, "wo")
+        u = as_uniform(u)
+        shape = np.broadcast_shapes(wo.shape[:-1], u.shape[:-1])
+        w, uu = _rows(wo, shape, 3), _rows(u, shape, 2)
+        wi = np.empty_like(w)
+        p = np.empty(w.shape[0])
+        _sample_rows(w, uu, float(self._values["alpha"]), self._values["distribution"] == "ggx",
+                     wi, p)
+        return wi.reshape(shape + (3,)), p.reshape(shape)
+
+    def pdf(self, wi, wo):
+        """Solid-angle density of :meth:`sample` (:func:`walter_pdf`); 0 for wo below."""
+        wi = as_directions(wi, "wi")
+        wo = as_directions(wo, "wo")
+        shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
+        p = np.empty(int(np.prod(shape)))
+        _pdf_rows(_rows(wi, shape, 3), _rows(wo, shape, 3), float(self._values["alpha"]),
+                  self._values["distribution"] == "ggx", p)
+        return p.reshape(shape)
 
 
 # =========================================================================== shared helpers

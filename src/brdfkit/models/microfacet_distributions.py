@@ -21,6 +21,11 @@ GGX / Trowbridge-Reitz (Walter eqs. 33-35; Lewis's D₃)
     :func:`d_ggx`, :func:`d_ggx_of_h` (from the half-vector components, no
     cancellation for tiny α), :func:`smith_g1_ggx`, :func:`ggx_g1_over_cos`,
     :func:`ggx_lambda`, :class:`GGX`.
+Formulas (:mod:`brdfkit._dual`: compiled by Numba, traced by Dr.Jit in the Mitsuba bridge)
+    :func:`d_ggx_of_h`, :func:`ggx_g1_over_cos`, :func:`beckmann_dg_over_cos`,
+    :func:`d_of_h` and :func:`sample_half` (the D cos θ_h sampler of both
+    distributions and its D); the Beckmann h(a) is a primitive (table for
+    Numba, ``erf`` for Dr.Jit).
 Phong lobe (Lewis's D₁, a sampling proposal)
     :class:`~brdfkit.models.sampling.PowerHalf` (the "phong" distribution).
 
@@ -38,6 +43,7 @@ import numba
 import numpy as np
 
 from brdfkit._array import stack
+from brdfkit._dual import cos, formula, log1p, maximum, minimum, primitive, select, sin, sqrt
 from brdfkit._kern import exp_nonpos
 from brdfkit.models.sampling import (
     COSINE,
@@ -50,6 +56,7 @@ from brdfkit.models.sampling import (
 
 _jit = numba.njit(cache=True, inline="always")
 SQRT_PI = math.sqrt(math.pi)
+PI = math.pi  # a constant of the formulas (brdfkit._dual reads no attributes)
 
 
 # =========================================================================== Beckmann
@@ -176,7 +183,7 @@ def d_ggx(cos_h: float, alpha: float) -> float:
     return a2 / (math.pi * t * t)
 
 
-@_jit
+@formula
 def ggx_g1_over_cos(cos_v: float, alpha: float) -> float:
     """G₁(v)/cos θ_v for GGX (Walter eq. 34, v·h > 0 assumed): 2/(c + √(c² + α² sin²θ_v)).
 
@@ -186,7 +193,7 @@ def ggx_g1_over_cos(cos_v: float, alpha: float) -> float:
     c = 0 (→ 2/α), where G₁ and c both underflow and G₁/c would be 0/0.
     """
     c2 = cos_v * cos_v
-    return 2.0 / (cos_v + math.sqrt(c2 + alpha * alpha * max(0.0, 1.0 - c2)))  # clamp: rounding
+    return 2.0 / (cos_v + sqrt(c2 + alpha * alpha * maximum(0.0, 1.0 - c2)))  # clamp: rounding
 
 
 @_jit
@@ -209,13 +216,25 @@ def _beckmann_h_total(a: float) -> float:
     return _beckmann_h_poly(x)
 
 
+def _beckmann_h_drjit(dr):
+    """h(a) = a√π (1 + erf a) + e^{−a²} in Dr.Jit (its ``erf``), a clamped as above."""
+    def h(a):
+        x = dr.clip(a, 0.0, G1_A_MAX)  # clamp: the formula's domain (discarded lanes)
+        return x * SQRT_PI * (1.0 + dr.erf(x)) + dr.exp(-x * x)
+    return h
+
+
+# a primitive of the formulas (brdfkit._dual): the table for Numba, erf for Dr.Jit
+primitive(_beckmann_h_total, _beckmann_h_drjit)
+
+
 @_jit
 def beckmann_lambda(a: float) -> float:
     """Smith Λ of Beckmann as a function of a = cot θ/α (> 0): G₁ = 1/(1 + Λ)."""
     return 1.0 / beckmann_g1_of_a(a) - 1.0
 
 
-@_jit
+@formula
 def _beckmann_g1_over_cos(cos_v: float, alpha: float):
     """(numerator, denominator) of G₁(v)/cos θ_v for Beckmann, branch-free and total.
 
@@ -223,14 +242,14 @@ def _beckmann_g1_over_cos(cos_v: float, alpha: float):
     exactly, see G1_A_MAX), as two selects: the cosine cancels out of the first form, so
     nothing underflows at grazing angles.
     """
-    s = math.sqrt(max(0.0, 1.0 - cos_v * cos_v))  # clamp: rounding near the pole
+    s = sqrt(maximum(0.0, 1.0 - cos_v * cos_v))  # clamp: rounding near the pole
     a = cos_v / (alpha * s)  # inf at the pole (s = 0): selected away below
     h = _beckmann_h_total(a)
     small = a < G1_A_MAX
-    return (2.0 * SQRT_PI if small else 1.0), (alpha * s * h if small else cos_v)
+    return select(small, 2.0 * SQRT_PI, 1.0), select(small, alpha * s * h, cos_v)
 
 
-@_jit
+@formula
 def beckmann_dg_over_cos(iz, oz, sxy2, sz2, alpha, inv_a2, live):
     """D G₁(ω_i) G₁(ω_o)/(4 cos θ_i cos θ_o) for Beckmann, Walter eqs. (20), (25), (27).
 
@@ -244,16 +263,16 @@ def beckmann_dg_over_cos(iz, oz, sxy2, sz2, alpha, inv_a2, live):
     t = sxy2 / sz2  # tan²θ_h, without the cancellation of (1 − cos²)/cos²
     e = -t * inv_a2  # −tan²θ_h/α²
     live = live & (e >= -700.0)  # NaN (0/0, discarded lanes) is not live
-    e = e if live else -1000.0  # e^{−1000} = 0 exactly (exp_nonpos)
-    sec2 = 1.0 + (t if live else 0.0)  # 1/cos²θ_h
+    e = select(live, e, -1000.0)  # e^{−1000} = 0 exactly (exp_nonpos)
+    sec2 = 1.0 + select(live, t, 0.0)  # 1/cos²θ_h
     ni, di = _beckmann_g1_over_cos(iz, alpha)
     no, do = _beckmann_g1_over_cos(oz, alpha)
-    den = 4.0 * math.pi * (alpha * alpha) * di * do
-    den = den if live else 1.0
+    den = 4.0 * PI * (alpha * alpha) * di * do
+    den = select(live, den, 1.0)
     return exp_nonpos(e) * (sec2 * sec2) * (ni * no) / den
 
 
-@_jit
+@formula
 def d_ggx_of_h(hz2: float, hxy2: float, inv_a2: float, alpha: float) -> float:
     """GGX D from the squared components of the unit half vector (hz² + |h_xy|² = 1).
 
@@ -262,7 +281,57 @@ def d_ggx_of_h(hz2: float, hxy2: float, inv_a2: float, alpha: float) -> float:
     min(1, 1/α²)/… ≥ 1/16 for α ≤ 4); 1/α² = inf gives D = 0 off the mirror.
     """
     u = hz2 + hxy2 * inv_a2
-    return 1.0 / (math.pi * (alpha * alpha) * (u * u))
+    return 1.0 / (PI * (alpha * alpha) * (u * u))
+
+
+# =========================================================================== sampling (formulas)
+U0_MAX = 1.0 - 1e-16  # the largest u₀ the samplers use: u₀ = 1 would map to θ_h = 90°
+TWO_PI = 2.0 * math.pi
+
+
+@formula
+def d_of_h(hx, hy, hz, alpha, ggx):
+    """D(h) of GGX (*ggx* true, Walter eq. 33) or Beckmann (eq. 25) at a unit vector h.
+
+    A formula (:mod:`brdfkit._dual`; *ggx* a Python constant): the density of
+    the samplers below with :func:`sample_half` (pdf D(h) cos θ_h). 0 for
+    h_z ≤ 0; Beckmann gives 0 where tan²θ_h/α² > 700 (D < 1e-290), as
+    :func:`beckmann_dg_over_cos`. tan²θ_h = |h_xy|²/h_z² (no 1 − cos²θ_h).
+    """
+    hz2 = hz * hz
+    hxy2 = hx * hx + hy * hy
+    a2 = alpha * alpha
+    up = hz > 0.0
+    if ggx:
+        u = hz2 + hxy2 / a2  # as d_ggx_of_h: no 1 − cos², ≥ 1/16
+        d = 1.0 / (PI * a2 * (u * u))
+    else:
+        t = hxy2 / hz2  # tan²θ_h (NaN or inf only where h_z ≤ 0: selected away)
+        e = -t / a2
+        up = up & (e >= -700.0)  # NaN is not up
+        sec2 = 1.0 + select(up, t, 0.0)  # 1/cos²θ_h
+        d = exp_nonpos(select(up, e, -1000.0)) * (sec2 * sec2) / (PI * a2)
+    return select(up, d, 0.0)
+
+
+@formula
+def sample_half(u0, u1, alpha, ggx):
+    """A half vector h with density D(h) cos θ_h from u₀, u₁ ∈ [0, 1) (formula).
+
+    tan²θ_h = α² u₀/(1 − u₀) (GGX, Walter eq. 35) or −α² ln(1 − u₀) (Beckmann,
+    eq. 28), φ_h = 2π u₁; cos θ_h = 1/√(1 + tan²θ_h) and sin θ_h = tan θ_h cos θ_h
+    (exact for tiny θ_h, no 1 − cos²).
+    """
+    u = minimum(u0, U0_MAX)  # clamp: u₀ = 1 maps to θ_h = 90°
+    a2 = alpha * alpha
+    if ggx:
+        tan2 = a2 * u / (1.0 - u)
+    else:
+        tan2 = -a2 * log1p(-u)
+    cos_h = 1.0 / sqrt(1.0 + tan2)
+    sin_h = sqrt(tan2) * cos_h
+    phi = TWO_PI * u1
+    return sin_h * cos(phi), sin_h * sin(phi), cos_h
 
 
 @_jit

@@ -2,13 +2,24 @@
 Any brdfkit model as a Mitsuba 3 BSDF
 =====================================
 
-The formulas stay written once, in brdfkit's compiled kernels: Mitsuba calls a
-Python BSDF with whole wavefronts (arrays of every path's directions) when
-Dr.Jit's symbolic loops, calls and conditionals are switched off
-(:func:`wavefront`), and the BSDF hands those arrays to ``model.eval``,
-``model.sample`` and ``model.pdf`` as NumPy float64 arrays. Measured against
-the alternative of tracing the kernels with Dr.Jit: see
-``benchmarks/bench_render_mitsuba.py``.
+The formulas stay written once. Two routes, chosen per model (``route="auto"``):
+
+- **traced** (models whose :meth:`~brdfkit.models.BRDF.formulas` are given;
+  today ``microfacet``, GGX and Beckmann, with or without Fresnel): the
+  formula functions that Numba compiles for ``model.eval``/``sample``/``pdf``
+  (:mod:`brdfkit._dual`) are rebound to Dr.Jit and called from a Python BSDF
+  that Dr.Jit traces into Mitsuba's kernel, in its default symbolic mode
+  (:mod:`brdfkit.render.mitsuba_traced`). As fast as Mitsuba's own BSDFs.
+- **wavefront** (every other model, the ``scalar_*`` variants, and RGB
+  channels in a spectral variant): Mitsuba calls a Python BSDF with whole
+  wavefronts (arrays of every path's directions) when Dr.Jit's symbolic loops,
+  calls and conditionals are switched off (:func:`wavefront`), and the BSDF
+  hands those arrays to ``model.eval``, ``model.sample`` and ``model.pdf`` as
+  NumPy float64 arrays. Works for anything; 8-9× the time of Mitsuba's
+  own BSDF at 256², 16 spp (see *Cost* below).
+
+A BSDF's ``traced`` attribute says which route it takes. The design record
+(why, the formula contract) is in ``docs/architecture.md``.
 
 Conventions (where the two libraries meet)
 ------------------------------------------
@@ -51,10 +62,13 @@ C on a ``wavelengths`` grid  error          error            interpolated at λ
   per-value upsampling (``srgb_model_fetch``) is scalar-only in Python.
 - *wavelength grid* (per-wavelength parameters, e.g. a metal's n, k): the
   model is built with C channels, channel c holding the parameters at
-  ``wavelengths[c]`` (nm, increasing); per path the bridge evaluates all C
-  channels and interpolates f_r linearly in λ at each of the path's 4
-  wavelengths (held constant outside the grid). The error is that of linear
-  interpolation of f_r(λ), h²/8·|∂²f/∂λ²| for spacing h: exact for a grey
+  ``wavelengths[c]`` (nm, increasing); per path the wavefront route evaluates
+  all C channels and interpolates f_r linearly in λ at each of the path's 4
+  wavelengths (held constant outside the grid); the traced route interpolates
+  the *parameters* (n, k) linearly at the path's wavelengths and evaluates
+  once, as Mitsuba's ``irregular`` spectra do (exact for parameters linear in
+  λ). Both are exact at the grid points; between them the error is that of
+  linear interpolation, h²/8·|∂²f/∂λ²| (of f_r, or of n, k) for spacing h: exact for a grey
   model, and for metals at 5-10 nm spacing far below Monte-Carlo noise (the
   n, k data themselves are tabulated at a similar spacing). The cost grows
   with C (all channels evaluated per path): keep grids to tens of points.
@@ -62,17 +76,20 @@ C on a ``wavelengths`` grid  error          error            interpolated at λ
 
 Cost, and a caveat
 ------------------
-Measured (``benchmarks/bench_render_mitsuba.py``, 256² sphere, 16 spp, two runs
-on a 2-core machine at load 4-6): the wavefront mode alone makes Mitsuba's own
-``roughconductor`` 2.9-4.5× slower than its default symbolic mode, and the
-bridge's ``microfacet`` (GGX) takes 6.4-12.5× the symbolic ``roughconductor``
-(brdfkit's NumPy samplers and the array conversions on top of the mode); the
-same GGX written in Dr.Jit operations and traced into Mitsuba's kernel takes
-0.64-0.73× (and gives the bridge's image to 1e-5 from the same seeds).
-While a bridge BSDF object is alive,
-Dr.Jit's symbolic calls trace it too and fail ("remains dirty"): render scenes
-with native BSDFs inside :func:`wavefront` as well, or drop the bridge objects
-(``del`` + ``gc.collect()``) first.
+Measured (``benchmarks/bench_render_mitsuba.py``, 256² sphere, 16 spp, GGX
+α = 0.2 conductor, medians of 5 renders in one process, two runs on a 2-core
+machine at load 5-9), as ratios to Mitsuba's own symbolic ``roughconductor``
+(same α, η, κ, spp, run): the traced ``microfacet`` 1.00-1.07× in
+``llvm_ad_rgb`` and 0.45-0.59× in ``llvm_ad_spectral`` (n, k on a 16-point
+grid; ``roughconductor`` reads them as ``irregular`` spectra); the wavefront
+route 7.8-9.4× and 3.5-3.9× (the wavefront mode alone makes
+``roughconductor`` 2.5-5.1× slower). The images agree within Monte-Carlo
+noise, and the two routes give the same image to 5e-7 from the same seeds
+(one sampler formula).
+While a wavefront-route BSDF object is alive, Dr.Jit's symbolic calls trace it
+too and fail ("remains dirty"): render scenes with native or traced BSDFs
+inside :func:`wavefront` as well, or drop the wavefront objects (``del`` +
+``gc.collect()``) first. Traced BSDFs render in either mode.
 
 Variants
 --------
@@ -88,9 +105,10 @@ Public objects
 - :func:`use_variant` — set a Mitsuba variant (with the fallback) and register
   the ``brdfkit`` plugin in it.
 - :func:`wavefront` — context manager: Dr.Jit's symbolic modes off (required
-  while rendering with the bridge in ``llvm_*`` variants).
+  while rendering with a wavefront-route BSDF in ``llvm_*`` variants).
 - :func:`mitsuba_bsdf` — a model object as a Mitsuba BSDF object (for a scene
-  dict: ``{"type": "sphere", "bsdf": mitsuba_bsdf(model)}``).
+  dict: ``{"type": "sphere", "bsdf": mitsuba_bsdf(model)}``), by the traced
+  route where possible (``route=`` to choose).
 - :func:`spectral_model` — a model with per-wavelength parameters on a grid.
 - The scene-dict plugin ``{"type": "brdfkit", "model": SPEC, PARAM: VALUE,
   …}``: ``SPEC`` a model name or material spec (``brdfkit.model(spec,
@@ -119,8 +137,9 @@ from brdfkit._specs import model as build_model
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models import BRDF
 from brdfkit.pumping import pump
+from brdfkit.render.mitsuba_traced import traced_class, traced_supported
 
-__all__ = ["FALLBACK", "VARIANTS", "mitsuba_bsdf", "spectral_model", "use_variant",
+__all__ = ["FALLBACK", "ROUTES", "VARIANTS", "mitsuba_bsdf", "spectral_model", "use_variant",
            "wavefront"]
 
 #: The variants the bridge supports, and the scalar variant each falls back to.
@@ -135,6 +154,7 @@ LUMINANCE = np.array([0.212671, 0.715160, 0.072169])
 _FLAGS = ("SymbolicLoops", "SymbolicCalls", "SymbolicConditionals")
 _REGISTERED: set[str] = set()
 _CLASSES: dict[str, type] = {}
+_TRACED: dict[str, type] = {}
 
 
 def _mitsuba():
@@ -184,8 +204,7 @@ def use_variant(variant: str = "llvm_ad_rgb") -> str:
         mi.set_variant(used)
         variant = used
     if variant not in _REGISTERED:
-        cls = _bsdf_class(variant)
-        mi.register_bsdf("brdfkit", lambda props: cls(props))
+        mi.register_bsdf("brdfkit", lambda props, v=variant: _plugin(props, v))
         _REGISTERED.add(variant)
     return variant
 
@@ -344,14 +363,10 @@ def _bsdf_class(variant: str) -> type:
     class BrdfkitBSDF(mi.BSDF):
         """A brdfkit model as a Mitsuba BSDF (see :mod:`brdfkit.render.mitsuba_bridge`)."""
 
-        def __init__(self, props, model: BRDF | None = None, wavelengths=None):
+        traced = False  # the wavefront route: render inside wavefront()
+
+        def __init__(self, props, model: BRDF, wavelengths=None):
             mi.BSDF.__init__(self, props)
-            if model is None:
-                model, wavelengths = _model_from_props(props)
-            if model.has_delta:
-                warnings.warn(f"brdfkit: {model.name}'s specular delta term is not rendered "
-                              "by the Mitsuba bridge (only its kernel)", RuntimeWarning,
-                              stacklevel=2)
             self.model = model
             self.colour = _ColourMap(mi, variant, model, _check_wavelengths(wavelengths, model))
             flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.DiffuseReflection
@@ -496,7 +511,37 @@ def _model_from_props(props) -> tuple[BRDF, list | None]:
     return m, wavelengths
 
 
-def mitsuba_bsdf(model: BRDF, *, wavelengths=None, variant: str | None = None):
+ROUTES = ("auto", "traced", "wavefront")
+
+
+def _make_bsdf(props, model: BRDF, wavelengths, variant: str, route: str):
+    """The traced BSDF when *route* allows and the model supports it, else the wavefront one."""
+    mi, dr = _mitsuba()
+    grid = _check_wavelengths(wavelengths, model)
+    _ColourMap(mi, variant, model, grid)  # validates channels against the variant
+    if model.has_delta:
+        warnings.warn(f"brdfkit: {model.name}'s specular delta term is not rendered "
+                      "by the Mitsuba bridge (only its kernel)", RuntimeWarning, stacklevel=3)
+    if route != "wavefront" and traced_supported(model, variant, grid):
+        if variant not in _TRACED:
+            _TRACED[variant] = traced_class(mi, dr, variant)
+        return _TRACED[variant](props, model, grid)
+    if route == "traced":
+        raise ParameterError(
+            f"route='traced' needs a model with formulas (model.formulas(); {model.name} has "
+            f"{'them' if model.formulas() is not None else 'none'}), an llvm_* variant "
+            f"(got {variant}) and grey, RGB or wavelength-grid channels; use route='auto'")
+    return _bsdf_class(variant)(props, model=model, wavelengths=wavelengths)
+
+
+def _plugin(props, variant: str):
+    """The scene-dict plugin ``{"type": "brdfkit", …}`` (route "auto")."""
+    model, wavelengths = _model_from_props(props)
+    return _make_bsdf(props, model, wavelengths, variant, "auto")
+
+
+def mitsuba_bsdf(model: BRDF, *, wavelengths=None, variant: str | None = None,
+                 route: str = "auto"):
     """*model* as a Mitsuba BSDF object of the current (or given) variant.
 
     Parameters
@@ -512,16 +557,24 @@ def mitsuba_bsdf(model: BRDF, *, wavelengths=None, variant: str | None = None):
         Switch to this variant first (:func:`use_variant`, with its fallback);
         None: the current Mitsuba variant (which must be one of
         :data:`VARIANTS`).
+    route : {"auto", "traced", "wavefront"}
+        ``auto``: the traced route when the model gives formulas and the
+        variant and channels allow it (module docstring), else the wavefront
+        route; ``traced`` insists (ParameterError otherwise); ``wavefront``
+        always calls the model's NumPy/Numba methods per wavefront.
 
     Returns
     -------
     mitsuba.BSDF
         Usable as a value in a scene dict (``"bsdf": mitsuba_bsdf(model)``),
-        in ``mi.chi2.BSDFAdapter``-style tests, or directly. Render inside
+        in ``mi.chi2.BSDFAdapter``-style tests, or directly. Its attribute
+        ``traced`` says which route it takes: False means render inside
         :func:`wavefront` in ``llvm_*`` variants.
     """
     if not isinstance(model, BRDF):
         raise ParameterError(f"model must be a brdfkit model (BRDF); got {type(model)!r}")
+    if route not in ROUTES:
+        raise ParameterError(f"route must be one of {', '.join(ROUTES)}; got {route!r}")
     mi, _ = _mitsuba()
     if variant is not None:
         variant = use_variant(variant)
@@ -532,8 +585,7 @@ def mitsuba_bsdf(model: BRDF, *, wavelengths=None, variant: str | None = None):
                 f"the current Mitsuba variant must be one of {', '.join(VARIANTS)}; it is "
                 f"{variant!r} (call brdfkit.render.mitsuba_bridge.use_variant first)")
         use_variant(variant)
-    cls = _bsdf_class(mi.variant())
-    return cls(mi.Properties("brdfkit"), model=model, wavelengths=wavelengths)
+    return _make_bsdf(mi.Properties("brdfkit"), model, wavelengths, mi.variant(), route)
 
 
 def spectral_model(name: str, wavelengths, **params) -> tuple[BRDF, np.ndarray]:

@@ -31,6 +31,7 @@ Public objects
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import numpy as np
@@ -152,7 +153,8 @@ def render_sphere_mitsuba(model: BRDF, *, phi_l: float = 0.0, ambient: float = 0
     scene = mi.load_dict(sphere_scene(bsdf, phi_l=phi_l, irradiance=irradiance,
                                       ambient=ambient, size=size, variant=used,
                                       illuminant=illuminant))
-    with wavefront():
+    # the traced route renders in Dr.Jit's default symbolic mode, the other one per wavefront
+    with contextlib.nullcontext() if bsdf.traced else wavefront():
         image = mi.render(scene, spp=int(spp), seed=int(seed))
     out = np.array(image, dtype=np.float64)
     if out.ndim == 2:

@@ -1,0 +1,232 @@
+"""
+Formulas written once, compiled by Numba and traced by Dr.Jit
+=============================================================
+
+A *formula* is a plain Python function of numbers, decorated with
+:func:`formula`. Its module-level version is a Numba ``njit`` function
+(inlined into the compiled model kernels, callable from Python); the same code
+object, with its global names bound to Dr.Jit's functions, is the version
+Mitsuba traces (:func:`drjit_version`), with arrays (``mi.Float``,
+``mi.Color3f``, ``mi.Spectrum``) or Python floats as arguments.
+
+The contract (checked by :func:`drjit_version`, which names the offending
+formula and name):
+
+- only arithmetic, comparisons, ``&`` and ``|`` of comparisons, tuple
+  indexing/packing and calls of *names*; no attribute access (``math.x``), no
+  loops, no ``not``/``and``/``or``/``~`` on values (they mean different things
+  to NumPy scalars and Dr.Jit arrays);
+- a branch on a value is a :func:`select` (both sides are evaluated, so both
+  must be finite or harmless: the kernels already were branch-free so that
+  Numba vectorises them). ``if`` is allowed only on Python constants that are
+  the same in both worlds (a compile-time flag such as ``ggx``);
+- every global name a formula reads is one of: another formula, a primitive
+  (below, or registered with :func:`primitive`), or a numeric constant
+  (``float``, ``int``, ``bool``). Constants keep their float64 values; in
+  Dr.Jit's single-precision variants they round to float32 where they meet an
+  array (1e-140 → 0, 2⁶⁰⁰ → inf): a formula's select-guarded corner cases for
+  float64 underflow are then inert, never NaN-producing (both branches finite
+  or the guard constant-false).
+
+Primitives (Numba → Dr.Jit)
+---------------------------
+==============  ==============================  ===========================
+name            Numba                           Dr.Jit
+==============  ==============================  ===========================
+select(c,a,b)   ``a if c else b``               ``dr.select``
+sqrt, exp, log  ``math.*``                      ``dr.*``
+log1p           ``math.log1p``                  Goldberg's log(1+x)·x/((1+x)−1)
+sin, cos        ``math.*``                      ``dr.*``
+minimum,        ``min``/``max``/``abs``         ``dr.minimum``/``maximum``/
+maximum,                                        ``abs``
+absolute
+exp_nonpos      :func:`brdfkit._kern.exp_nonpos` ``dr.exp``
+==============  ==============================  ===========================
+
+plus those other modules register (:func:`primitive`), e.g. the Beckmann
+h(a) of :mod:`brdfkit.models.microfacet_distributions` (a table without libm
+calls for Numba, ``dr.erf`` for Dr.Jit).
+
+References
+----------
+- W. Jakob, S. Speierer, N. Roussel, D. Vicini, *Dr.Jit: A Just-In-Time
+  Compiler for Differentiable Rendering*, ACM TOG 41(4), 2022 (tracing).
+- D. Goldberg, *What every computer scientist should know about floating-point
+  arithmetic*, ACM Computing Surveys 23(1), 1991, Theorem 4 (log1p).
+"""
+
+from __future__ import annotations
+
+import dis
+import math
+import types
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numba
+
+from brdfkit._kern import exp_nonpos
+
+__all__ = ["Formulas", "formula", "primitive", "drjit_version", "select", "sqrt", "exp", "log",
+           "log1p", "sin", "cos", "minimum", "maximum", "absolute", "exp_nonpos"]
+
+_jit = numba.njit(cache=True, inline="always")
+
+#: py_func of every formula → its Numba dispatcher
+_FORMULAS: dict[Callable, object] = {}
+#: Numba-side primitive object → factory dr ↦ its Dr.Jit counterpart
+_PRIMITIVES: dict[object, Callable] = {}
+_DRJIT: dict[Callable, Callable] = {}  # memo: py_func → Dr.Jit version
+
+
+@dataclass(frozen=True)
+class Formulas:
+    """A model's f_r, sampler and pdf as formulas (what ``BRDF.formulas()`` returns).
+
+    ============  ================================================================
+    field         meaning
+    ============  ================================================================
+    eval          ``eval(ix, iy, iz, ox, oy, oz, p) -> f_r`` for one channel's
+                  packed row *p* (``model.packed[c]``; indexed, never iterated),
+                  wi = (ix, iy, iz) toward the light, wo toward the viewer, local
+                  frame, 0 below the horizon; equal to ``model.eval``
+    sample        ``sample(ox, oy, oz, u0, u1, *args) -> (ix, iy, iz)``: the
+                  model's sampler (the same directions as ``model.sample``)
+    pdf           ``pdf(ix, iy, iz, ox, oy, oz, *args) -> p``: its solid-angle
+                  density (``model.pdf``)
+    args          the sampler's parameters (Python floats, the same for every
+                  channel)
+    ============  ================================================================
+    """
+
+    eval: Callable
+    sample: Callable
+    pdf: Callable
+    args: tuple = ()
+
+
+def formula(f=None, **options):
+    """Decorator: *f* as a formula (module docstring); returns its Numba version.
+
+    ``options`` go to ``numba.njit`` (default ``cache=True, inline="always",
+    error_model="numpy"``).
+    """
+    def deco(fn):
+        # error_model "numpy": a select evaluates both sides, a discarded one may divide by 0
+        opts = {"cache": True, "inline": "always", "error_model": "numpy", **options}
+        disp = numba.njit(**opts)(fn)
+        _FORMULAS[fn] = disp
+        return disp
+
+    return deco if f is None else deco(f)
+
+
+def primitive(obj, drjit: Callable):
+    """Register the Numba-side *obj* (a function a formula calls by name) with the factory
+    ``drjit(dr) -> function`` of its Dr.Jit counterpart; returns *obj*."""
+    _PRIMITIVES[obj] = drjit
+    return obj
+
+
+@_jit
+def select(c, a, b):
+    """a where c holds, else b (both evaluated)."""
+    return a if c else b
+
+
+@_jit
+def minimum(a, b):
+    return min(a, b)
+
+
+@_jit
+def maximum(a, b):
+    return max(a, b)
+
+
+@_jit
+def absolute(a):
+    return abs(a)
+
+
+sqrt = math.sqrt
+exp = math.exp
+log = math.log
+log1p = math.log1p
+sin = math.sin
+cos = math.cos
+
+
+def _log1p_drjit(dr):
+    def log1p_(x):
+        u = 1.0 + x
+        # Goldberg (1991) Thm. 4: log(u)·x/(u − 1) is accurate where u rounds; u = 1: x
+        return dr.select(u == 1.0, x, dr.log(u) * (x / dr.select(u == 1.0, 1.0, u - 1.0)))
+    return log1p_
+
+
+for _obj, _factory in (
+        (select, lambda dr: dr.select), (minimum, lambda dr: dr.minimum),
+        (maximum, lambda dr: dr.maximum), (absolute, lambda dr: dr.abs),
+        (sqrt, lambda dr: dr.sqrt), (exp, lambda dr: dr.exp), (log, lambda dr: dr.log),
+        (log1p, _log1p_drjit), (sin, lambda dr: dr.sin), (cos, lambda dr: dr.cos),
+        (exp_nonpos, lambda dr: dr.exp)):
+    primitive(_obj, _factory)
+
+_CONSTANT_TYPES = (float, int, bool)
+# opcodes a formula may not contain (attribute access, loops, ~): see the contract
+_FORBIDDEN = {"LOAD_ATTR", "LOAD_METHOD", "FOR_ITER", "UNARY_INVERT", "UNARY_NOT",
+              "GET_ITER", "MAKE_FUNCTION", "IMPORT_NAME"}
+
+
+def _py(f):
+    return f.py_func if isinstance(f, numba.core.dispatcher.Dispatcher) else f
+
+
+def drjit_version(f) -> Callable:
+    """The Dr.Jit version of the formula *f* (its Numba dispatcher or Python function).
+
+    The same code object, with a namespace in which every global name the
+    formula reads is its Dr.Jit counterpart (formulas recursively); built once
+    and cached. Raises ``TypeError`` naming the formula and the name when the
+    contract (module docstring) is broken.
+    """
+    import drjit as dr
+
+    py = _py(f)
+    if py in _DRJIT:
+        return _DRJIT[py]
+    if py not in _FORMULAS:
+        raise TypeError(f"{py.__qualname__} is not a formula (decorate it with @formula)")
+    code = py.__code__
+    bad = sorted({i.opname for i in dis.get_instructions(code)} & _FORBIDDEN)
+    if bad:
+        raise TypeError(f"formula {py.__qualname__} uses {', '.join(bad)} (not traceable; "
+                        "see brdfkit._dual)")
+    ns: dict = {"__name__": py.__globals__.get("__name__"), "__builtins__": {}}
+    new = types.FunctionType(code, ns, py.__name__, py.__defaults__)
+    _DRJIT[py] = new  # before the names: formulas may call each other
+    for name in code.co_names:
+        value = py.__globals__.get(name)
+        inner = _py(value) if value is not None else None
+        if inner in _FORMULAS:
+            ns[name] = drjit_version(inner)
+        elif _hashable(value) and value in _PRIMITIVES:
+            ns[name] = _PRIMITIVES[value](dr)
+        elif isinstance(value, _CONSTANT_TYPES):
+            ns[name] = value
+        else:
+            del _DRJIT[py]
+            what = type(value).__name__ if name in py.__globals__ else "a builtin"
+            raise TypeError(f"formula {py.__qualname__} reads the global {name!r} "
+                            f"({what}), which is neither a formula, a primitive nor a "
+                            "numeric constant (see brdfkit._dual)")
+    return new
+
+
+def _hashable(value) -> bool:
+    try:
+        hash(value)
+    except TypeError:
+        return False
+    return True
