@@ -38,7 +38,7 @@ from brdfkit.fitting.samples import albedo_from_values, albedo_nodes
 __all__ = ["Problem", "IRLS_ITERATIONS"]
 
 #: IRLS steps of the L1 linear solve.
-IRLS_ITERATIONS = 6
+IRLS_ITERATIONS = 3
 #: Relative tolerance of the numerical linearity test.
 LINEAR_RTOL = 1e-6
 #: θ_i of the albedo term of the perceptual loss (degrees) and its node counts.

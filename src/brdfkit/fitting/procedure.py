@@ -92,7 +92,10 @@ STATUS_MESSAGES = {
 #: common scale of C_xy, C_z against rho_s) there is no parameter tolerance to reach.
 FRTOL, FRTOL_POLISH = 1e-5, 1e-5
 #: Restarts of a Nelder–Mead run from its best point (see _nelder_mead).
-NM_RESTARTS = 3
+NM_RESTARTS = 1
+#: A Nelder–Mead run stops after this many evaluations per coordinate without a
+#: significant improvement (see _nelder_mead).
+STALL_EVALS = 10
 #: Losses whose linear solve is exact (the L1 one by IRLS to convergence at the end).
 EXACT_PROJECTION = ("l1", "l2", "ngan")
 #: IRLS steps of the final L1 linear solve (the search's solves take IRLS_ITERATIONS,
@@ -194,32 +197,57 @@ def _measured_half_width(target) -> float:
     return float(th[below[0]]) if below.size else math.pi / 4
 
 
+class _Stalled(Exception):
+    """Raised inside a Nelder–Mead run to stop it (see _nelder_mead)."""
+
+
 def _nelder_mead(fun, z0, steps, maxfev, scale, fatol):
     """Nelder–Mead from z0 with an initial simplex of the given steps; the loss is
     divided by *scale* (a loss near the optimum: a change below *fatol* of it is
-    negligible, also where the loss tends to 0 on exact data). A run's stop is checked by
-    restarting from its best point with a fresh simplex of half the steps (the standard
-    remedy for a collapsed simplex: along a curved valley, e.g. Nielsen's s against α, the
-    simplex can flatten and stop short of the optimum), again while a restart improves the
-    loss by more than *fatol*, at most :data:`NM_RESTARTS` times; *maxfev* evaluations in
-    all. Returns (z, value, n_evaluations, hit_limit)."""
+    negligible, also where the loss tends to 0 on exact data).
+
+    A run stops when the losses at the simplex's vertices agree to *fatol*, or when
+    :data:`STALL_EVALS` × n evaluations in a row have not lowered the best loss by more
+    than *fatol* (stalled: crawling along a flat valley, e.g. Lafortune's common scale of
+    C_xy, C_z against ρ_s, or towards a bound approached only asymptotically in z; the
+    bound is then reported by _flat_to_bound). The stop is checked by restarting once from
+    the best point with a fresh simplex of half the steps (the standard remedy for a
+    collapsed simplex: along a curved valley, e.g. Nielsen's s against α, the simplex can
+    flatten and stop short). *maxfev* evaluations in all. Returns (z, value,
+    n_evaluations, hit_limit)."""
     z = np.asarray(z0, dtype=np.float64)
     n = z.size
-    nfev = 0
-    best = math.inf
+    st = {"n": 0, "best": math.inf, "z": z, "ref": math.inf, "since": 0}
+
+    def f(x):
+        v = fun(x) / scale
+        st["n"] += 1
+        if v < st["best"]:
+            st["best"], st["z"] = v, np.array(x, dtype=np.float64)
+        if v < st["ref"] - fatol:  # a significant improvement
+            st["ref"], st["since"] = v, 0
+        else:
+            st["since"] += 1
+            if st["since"] >= STALL_EVALS * n:
+                raise _Stalled
+        return v
+
     for run in range(1 + NM_RESTARTS):
+        before = st["best"]
+        st["ref"], st["since"] = st["best"], 0
         h = np.asarray(steps, dtype=np.float64) * (0.5 if run else 1.0)
-        simplex = np.vstack([z] + [z + np.eye(n)[k] * h[k] for k in range(n)])
-        res = minimize(lambda x: fun(x) / scale, z, method="Nelder-Mead",
-                       options={"initial_simplex": simplex, "maxfev": maxfev - nfev,
-                                "xatol": math.inf, "fatol": fatol, "adaptive": n > 2})
-        nfev += int(res.nfev)
-        gain = best - float(res.fun)
-        if float(res.fun) < best:
-            z, best = res.x, float(res.fun)
-        if gain <= fatol or nfev >= maxfev:
+        zs = st["z"]
+        simplex = np.vstack([zs] + [zs + np.eye(n)[k] * h[k] for k in range(n)])
+        try:
+            with np.errstate(invalid="ignore"):  # inf − inf at refused vertices: not a stop
+                minimize(f, zs, method="Nelder-Mead",
+                         options={"initial_simplex": simplex, "maxfev": maxfev - st["n"],
+                                  "xatol": math.inf, "fatol": fatol, "adaptive": n > 2})
+        except _Stalled:
+            pass
+        if before - st["best"] <= fatol or st["n"] >= maxfev:
             break
-    return z, best * scale, nfev, nfev >= maxfev
+    return st["z"], st["best"] * scale, st["n"], st["n"] >= maxfev
 
 
 def _free_coords(model, fixed, C):
@@ -463,7 +491,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
     if procedure != "direct" and shape and not pumped_start:
         n0 = n_evals()
         before = prob.loss_at(values)
-        budget = max(max_evals, 60 * len(shape))
+        budget = max(max_evals, 100 * len(shape))
         steps = np.array([c.step(_val(values, c)) for c in shape])
         shape_names = {c.name for c in shape}
         defaults = dict(values)
@@ -519,7 +547,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
             if best is None or val < best[0]:
                 best = (val, end, limit)
         values = best[1]
-        hit_limit |= best[2]
+        hit_limit = best[2]  # superseded by stage (iii)'s: the last stage decides the status
         after = prob.loss_at(values)
         if linear:  # the linear parameters re-solved on the fit's own samples
             solved = solve_at(prob, values, want_loss=True)
@@ -548,13 +576,15 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         # a tenth of stage (ii)'s steps: stage (iii) starts near a stationary point
         steps = 0.1 * np.array([c.step(_val(values, c)) for c in free3])
         end, val, _, limit = search(prob, free3, values, projected3,
-                                    max(max_evals, 40 * len(free3)), steps, FRTOL_POLISH)
+                                    max(max_evals, 60 * len(free3)), steps, FRTOL_POLISH)
         if projected3:  # the final linear solve to convergence (IRLS_FINAL steps for l1)
             end = solve_at(prob, end, iterations=IRLS_FINAL) or end
             val = prob.loss_at(end)
         if val <= before:
             values = end
-        hit_limit |= limit
+        # the final stage's stop decides: a stage-(ii) search cut by its budget and then
+        # polished here to the tolerance is a converged result (its limit stays recorded)
+        hit_limit = limit
         stage_record("iii: " + ("shape and shape-dependent linear" if procedure == "nielsen"
                                 else "shape, linear re-solved (= all jointly)" if projected3
                                 else "all"), [c.label for c in free3], n0, before,
