@@ -9,7 +9,6 @@ parameters synthetic targets were made with.
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 import brdfkit
@@ -20,9 +19,11 @@ from brdfkit.fitting.procedure import AT_BOUND
 def test_free_eta_never_makes_the_nielsen_fit_worse():
     # Regression: with η free (Fresnel on) Nielsen's procedure ended at L1 ≈ 0.0209 with
     # s → 1e6 and η → 0.01, reported "converged", where without η it reached ≈ 0.0127.
+    # (coarser samples than the default, for speed: the identity holds on any samples)
     target = brdfkit.data.material("merl:two-layer-silver")
-    without = fit(brdfkit.model("nielsen"), target, procedure="nielsen")
-    with_eta = fit(brdfkit.model("nielsen", eta=1.5), target, procedure="nielsen")
+    kw = dict(procedure="nielsen", strides=(15, 45))
+    without = fit(brdfkit.model("nielsen"), target, **kw)
+    with_eta = fit(brdfkit.model("nielsen", eta=1.5), target, **kw)
     # nested models: min over (…, η) ≤ min over (…) with F = 1 (η → 0), up to the stopping
     # tolerance and F(η = 1e-6) = 1 − O(1e-6) at normal incidence
     assert with_eta.value <= without.value * (1.0 + 1e-4)
@@ -35,20 +36,23 @@ def test_free_eta_never_makes_the_nielsen_fit_worse():
 
 
 def test_eta_is_recovered_and_an_undetermined_eta_is_reported_at_its_bound():
-    # Synthetic targets: Nielsen's model evaluated at the MERL grid's bin centres.
-    truth = dict(rho_d=[0.05, 0.1, 0.15], k_s=[30.0, 25.0, 20.0], s=300.0, alpha=0.3)
+    # Synthetic grey targets: Nielsen's model evaluated at the MERL grid's bin centres.
+    truth = dict(rho_d=0.1, k_s=30.0, s=300.0, alpha=0.3)
     # (a) η = 1.5 in the target, fitted from η = 1.2: every parameter back
     r = fit(brdfkit.model("nielsen", eta=1.2), brdfkit.model("nielsen", eta=1.5, **truth))
     assert r.success, r.message
-    np.testing.assert_allclose(r.params["eta"], 1.5, rtol=2e-2)
+    assert r.params["eta"] == pytest.approx(1.5, rel=2e-2)
     assert r.params["s"] == pytest.approx(300.0, rel=2e-2)
     assert r.params["alpha"] == pytest.approx(0.3, abs=2e-2)
-    np.testing.assert_allclose(r.params["k_s"], truth["k_s"], rtol=3e-2)
+    assert r.params["k_s"] == pytest.approx(30.0, rel=3e-2)
+    assert r.params["rho_d"] == pytest.approx(0.1, rel=1e-2)
     # (b) the target has F = 1 (no η: the limit η → 0): the fit matches it and says that η
     # sits at (is indistinguishable from) its lower bound, never plain "converged"
     r = fit(brdfkit.model("nielsen", eta=1.5), brdfkit.model("nielsen", **truth))
     assert r.metrics["l1"] <= 1e-4 * r.convergence["stages"][0]["loss_before"]
     assert r.status == AT_BOUND, r.message
-    named = {b["parameter"] for b in r.convergence["at_bounds"]}
-    assert {"eta[0]", "eta[1]", "eta[2]"} <= named, r.message
-    assert "eta[0]" in r.message
+    assert "eta" in {b["parameter"] for b in r.convergence["at_bounds"]}, r.message
+    assert "eta" in r.message
+    # reproducible with the same seed
+    again = fit(brdfkit.model("nielsen", eta=1.5), brdfkit.model("nielsen", **truth))
+    assert again.params == r.params

@@ -18,33 +18,65 @@ optional ones that are None (e.g. no η: F = 1 stays so) and those in
 parameters per lobe. A parameter that changes nothing on the samples (e.g. an
 extinction coefficient without an η) is held and reported as ``inert``.
 Linear parameters (colour parameters the model is affine in, found
-numerically; see :mod:`brdfkit.fitting._problem`) are solved in closed form;
-the others ("shape") are optimised over bounded reparametrisations
+numerically for each candidate and then jointly — so a non-linear colour
+parameter such as η does not stop ρ_d, k_s from being linear; see
+:mod:`brdfkit.fitting._problem`) are solved in closed form; the others
+("shape") are optimised over bounded reparametrisations
 (:mod:`brdfkit.fitting._space`) with Nelder–Mead.
 
+Stages of ``procedure="staged"`` (= ``"auto"``, any model):
+
+(i) first guess and linear parameters: the width parameter (the model's
+    ``width_param``) from the measured peak's half-width β (via
+    ``width_from_beta``) and from the ladder β = 0.5°, 1°, …, 64°
+    (:data:`BETA_LADDER_DEG`), each with the linear parameters solved; the
+    width of least loss is kept (a measured peak alone can mislead: the clear
+    coat of two-layer-silver gives β → 0, s ≈ 10⁶, a local optimum on the
+    spike far from the broad lobe); the linear parameters solved there.
+(ii) search over the shape parameters on a coarser grid
+    (:data:`SEARCH_STRIDES`: ~1,600 samples, every θ_h bin kept) with the
+    linear ones re-solved at every evaluation (variable projection), from
+    several starts: the guess; with free optional parameters (η), the same
+    model without them fitted first (recursively) and its optimum with those
+    parameters where they change the model least (the z of
+    :data:`NEUTRAL_Z` of least loss; for η: η → 0, F = 1 under total internal
+    reflection) — so a free optional parameter never makes the fit worse;
+    the declared defaults (an optional parameter declared None keeps its
+    value); ``n_starts − 2`` random ones (z of the guess plus N(0, 1), from
+    ``numpy.random.default_rng(seed)``). Every run is recorded; once two runs
+    reach the same loss (relative difference ≤ :data:`CONSENSUS`) the
+    remaining starts are recorded as skipped.
+(iii) polish on the fit's own samples from the best run: for l1, l2 and ngan
+    the shape with the linear parameters re-solved — variable projection is
+    exact for them (min over (shape, linear) = min over shape of the loss with
+    the linear part solved), so this is the joint optimum, the final L1 solve
+    run to convergence (:data:`IRLS_FINAL` steps); for log and perceptual
+    (linear part solved under L2) all free parameters jointly under the loss.
+
 ``procedure="nielsen"`` (Nielsen et al. 2015, "Fitting Results and
-Observations"): (i) the linear parameters (ρ_d and k_s) in closed form at
-the first guess; (ii) the shape parameters (s, α and η) with the linear ones
-held; (iii) the shape parameters with the linear parameters whose basis
-depends on the shape (k_s, not ρ_d: as the paper's stage (iii) frees s, α,
-k_s). ``procedure="staged"`` (any model): (i) as above; (ii) the shape
-parameters with the linear ones re-solved at every evaluation (variable
-projection: exact for l1/l2/ngan); (iii) all free parameters jointly under the
-loss. ``"auto"``: ``staged``. ``"direct"``: all free parameters jointly from
-the first guess (one stage, no linear solve: the plain approach, for
-comparison).
+Observations"): (i) as above (ρ_d and k_s); (ii) the shape parameters (s, α
+and η) with the linear ones solved at each start and then held; (iii) the
+shape parameters with the linear parameters whose basis depends on the shape
+(k_s, not ρ_d: as the paper's stage (iii) frees s, α, k_s), jointly under
+the loss. ``"direct"``: all free parameters jointly from the first guess (one
+stage, no linear solve: the plain approach, for comparison).
 
 A pumped model (no linear parameters: g depends on them) is started from the fit of its
 unpumped root (the root's own staged fit as stage (ii)), then stage (iii) optimises all its
 parameters jointly.
 
-Stage (ii) runs from several starts: the data-driven first guess (the width
-parameter from the measured peak's half-width β via the model's
-``width_from_beta``, the other shape parameters at their defaults), the
-declared defaults, and ``n_starts − 2`` random starts (z of the guess plus
-N(0, 1), from ``numpy.random.default_rng(seed)``). Every run is recorded; once
-two runs reach the same loss (relative difference ≤ :data:`CONSENSUS`) the
-remaining starts are recorded as skipped.
+Stopping and status: a Nelder–Mead run stops when its vertices' losses agree
+to :data:`FRTOL` of the loss after stage (i), or after :data:`STALL_EVALS`
+evaluations per coordinate without such an improvement (a flat valley, or a
+bound approached asymptotically in z); its stop is checked by one restart
+from the best point. The status is set by the last stage: MAX_EVALS when it
+reached its budget (a stage-(ii) search cut by its budget and then polished
+to the tolerance is recorded but converged). Bounds are checked after the
+last stage: a coordinate at a bound, or one the loss cannot tell from a bound
+(moved there the loss rises by less than :data:`BOUND_LOSS_RTOL` relative;
+the bound is taken if the loss falls), is reported (``at_bounds``, status
+AT_BOUND, named in the message) — never a plain "converged". Every stage
+record lists the coordinates at a bound after it.
 
 The fit evaluates on one thread (``numba.set_num_threads(1)``, restored
 after): for ~15,000 pairs the parallel driver's thread wake-ups cost more
