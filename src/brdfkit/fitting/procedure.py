@@ -439,7 +439,10 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         for k, n in enumerate(lin_names):
             out[n] = P[k].copy() if C > 1 else float(P[k, 0])
         # the model is affine in the linear parameters: its values from the bases
-        return out, f0 + sum(Bk * P[k][None, :] for k, Bk in enumerate(B)), B
+        pred = f0.copy()
+        for k, Bk in enumerate(B):
+            pred += Bk * P[k][None, :]
+        return out, pred, B
 
     def solve_at(p, vals, want_loss=False, iterations=IRLS_ITERATIONS):
         """*vals* with the linear parameters solved on problem *p* (and its loss)."""
@@ -608,7 +611,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         # a tenth of stage (ii)'s steps: stage (iii) starts near a stationary point
         steps = 0.1 * np.array([c.step(_val(values, c)) for c in free3])
         end, val, _, limit = search(prob, free3, values, projected3,
-                                    max(max_evals, 60 * len(free3)), steps, FRTOL_POLISH)
+                                    max(max_evals, 100 * len(free3)), steps, FRTOL_POLISH)
         if projected3:  # the final linear solve to convergence (IRLS_FINAL steps for l1)
             end = solve_at(prob, end, iterations=IRLS_FINAL) or end
             val = prob.loss_at(end)
