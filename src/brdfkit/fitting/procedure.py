@@ -137,7 +137,7 @@ IRLS_FINAL = 50
 CONSENSUS = 1e-4
 #: Stage (ii) searches on this coarser merging of MERL bins (θ_d, φ_d; every θ_h bin kept):
 #: ~1,600 samples instead of ~8,100; stage (iii) polishes on the fit's own samples.
-SEARCH_STRIDES = (15, 45)
+SEARCH_STRIDES = (9, 45)
 #: Half-widths (degrees) scanned for the first guess of the width parameter (with the
 #: measured one): mirror-like to broad, a factor 2 apart.
 BETA_LADDER_DEG = (0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0)
