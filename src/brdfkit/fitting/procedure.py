@@ -629,6 +629,33 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
                                 else "all"), [c.label for c in free3], n0, before,
                      min(val, before), limit, values)
     values, flat = _flat_to_bound(prob, values, coords)
+    if free3 and hit_limit:
+        # the polish was still crawling, typically towards a bound approached only
+        # asymptotically in z: the coordinates at (or indistinguishable from) a bound are
+        # set there and held, and the polish is run once more over the others
+        held = [c for c in free3 if c.label in flat or c.at_bound(_val(values, c))]
+        rest = [c for c in free3 if c not in held]
+        if held and rest:
+            n0 = n_evals()
+            before = prob.loss_at(values)
+            start = values
+            for c in held:
+                side = flat[c.label][0] if c.label in flat else c.at_bound(_val(values, c))
+                start = from_vector([Z_MAX if side == "upper" else -Z_MAX], [c], start)
+            steps = 0.1 * np.array([c.step(_val(start, c)) for c in rest])
+            end, val, _, limit = search(prob, rest, start, projected3,
+                                        max(max_evals, 100 * len(rest)), steps, FRTOL_POLISH)
+            if projected3:
+                end = solve_at(prob, end, iterations=IRLS_FINAL) or end
+                val = prob.loss_at(end)
+            if val <= before:
+                values, hit_limit = end, limit
+                values, flat = _flat_to_bound(prob, values, coords)
+            elif not limit:  # stopped by the tolerance without a gain: a converged point
+                hit_limit = False
+            stage_record("iii': polish with " + ", ".join(c.label for c in held)
+                         + " held at their bounds", [c.label for c in rest], n0, before,
+                         min(val, before), limit, values)
     record["evaluations_search"] = sp.n_evals if sp is not prob else 0
     return _result(prob, target, values, coords, record, hit_limit, t_start, flat, n_evals())
 
