@@ -71,7 +71,10 @@ evaluations per coordinate without such an improvement (a flat valley, or a
 bound approached asymptotically in z); its stop is checked by one restart
 from the best point. The status is set by the last stage: MAX_EVALS when it
 reached its budget (a stage-(ii) search cut by its budget and then polished
-to the tolerance is recorded but converged). Bounds are checked after the
+to the tolerance is recorded but converged). A polish cut by its budget is
+run once more (stage "iii'") with the coordinates at (or indistinguishable
+from) a bound set there and held: it converges where the crawl was towards a
+bound approached only asymptotically in z. Bounds are checked after the
 last stage: a coordinate at a bound, or one the loss cannot tell from a bound
 (moved there the loss rises by less than :data:`BOUND_LOSS_RTOL` relative;
 the bound is taken if the loss falls), is reported (``at_bounds``, status
@@ -433,7 +436,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
 
     def project(p, vals, iterations=IRLS_ITERATIONS):
         """(*vals* with the linear parameters solved on problem *p*, the model's values
-        from the bases, the bases), or None when refused."""
+        from the bases), or None when refused."""
         got = p.bases(vals, linear) if linear else None
         if got is None:
             return None
@@ -446,14 +449,14 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         pred = f0.copy()
         for k, Bk in enumerate(B):
             pred += Bk * P[k][None, :]
-        return out, pred, B
+        return out, pred
 
     def solve_at(p, vals, want_loss=False, iterations=IRLS_ITERATIONS):
         """*vals* with the linear parameters solved on problem *p* (and its loss)."""
         got = project(p, vals, iterations)
         if got is None:
             return (None, math.inf) if want_loss else None
-        out, pred, _ = got
+        out, pred = got
         if not want_loss:
             return out
         if loss == "perceptual":  # needs the model's albedo: evaluate it
