@@ -553,7 +553,8 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
                          procedure, {k: v for k, v in fixed.items() if k not in nested},
                          theta_max, seed, n_starts, strides, max_evals)
             record["nested"] = {"without": nested, "value": inner.value,
-                                "status": inner.status, "params": inner.params}
+                                "status": inner.status, "params": inner.params,
+                                "evaluations": inner.convergence["evaluations"]}
             start = {**values, **{k: (np.asarray(v, dtype=np.float64)
                                       if isinstance(v, list) else v)
                                   for k, v in inner.params.items() if k not in nested}}
