@@ -11,7 +11,7 @@ parameters, r (N) the target minus the offset and w (N) the sample measures:
   one with the least objective kept (the convex problem's minimiser satisfies
   KKT, so it is one of them);
 - :func:`solve_channel` — the L2 solution (G = Aᵀ diag(w) A, b = Aᵀ diag(w) r),
-  then for L1 (from ``p_start`` when given: the previous
+  then for L1 (from ``p_start`` instead when given: the previous
   solution of a nearby shape) iteratively reweighted least squares: weights
   w_j / max(|A p − r|_j, ε), ε = 10⁻⁹ × mean |r| (bounds the weight of an
   exactly fitted sample), each step a box solve, until p changes by less than
@@ -145,12 +145,13 @@ def _normal(A, r, u):  # pragma: no cover - compiled
 @numba.njit(cache=True)
 def solve_channel(A, r, w, lo, hi, l1, iterations, p_start):  # pragma: no cover - compiled
     N, K = A.shape
-    G, b = _normal(A, r, w)
-    p = box_lstsq(G, b, lo, hi)
-    if not l1:
-        return p
-    if p_start.size == K:  # warm start (IRLS from the previous solution of a nearby shape)
-        p = p_start.copy()
+    if l1 and p_start.size == K:  # warm start (IRLS from the previous solution of a nearby
+        p = p_start.copy()        # shape): the L2 start is not needed
+    else:
+        G, b = _normal(A, r, w)
+        p = box_lstsq(G, b, lo, hi)
+        if not l1:
+            return p
     mean_r = 0.0
     for j in range(N):
         mean_r += abs(r[j])

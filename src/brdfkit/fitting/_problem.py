@@ -38,7 +38,7 @@ from brdfkit.fitting.samples import albedo_from_values, albedo_nodes
 __all__ = ["Problem", "IRLS_ITERATIONS"]
 
 #: IRLS steps of the L1 linear solve.
-IRLS_ITERATIONS = 6
+IRLS_ITERATIONS = 3
 #: Relative tolerance of the numerical linearity test.
 LINEAR_RTOL = 1e-6
 #: θ_i of the albedo term of the perceptual loss (degrees) and its node counts.
@@ -178,16 +178,18 @@ class Problem:
         scale = max(float(np.max(np.abs(expect))), 1e-300)
         return float(np.max(np.abs(got_f - expect))) <= LINEAR_RTOL * scale
 
-    def solve_linear(self, f0, B, lo, hi, loss: str) -> np.ndarray:
-        """Per-channel linear parameters (K, C) minimising the L1 (``l1``) or L2 (other
-        losses) norm (:func:`brdfkit.fitting._linear.solve_channel`)."""
+    def solve_linear(self, f0, B, lo, hi, loss: str, *,
+                     iterations: int = IRLS_ITERATIONS) -> np.ndarray:
+        """Per-channel linear parameters (K, C) minimising the L1 (``l1``, at most
+        *iterations* IRLS steps) or L2 (other losses) norm
+        (:func:`brdfkit.fitting._linear.solve_channel`)."""
         P = np.empty((len(B), self.C))
         for c in range(self.C):
             A = np.ascontiguousarray(np.stack([Bk[:, c] for Bk in B], axis=1))
             r = np.ascontiguousarray(self.y[:, c] - f0[:, c])
             start = self._warm[:, c] if self._warm is not None and self._warm.shape == P.shape \
                 else np.empty(0)
-            P[:, c] = solve_channel(A, r, self.w, lo, hi, loss == "l1", IRLS_ITERATIONS,
+            P[:, c] = solve_channel(A, r, self.w, lo, hi, loss == "l1", iterations,
                                     np.ascontiguousarray(start))
         self._warm = P.copy()
         return P

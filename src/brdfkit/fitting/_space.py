@@ -25,13 +25,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Coord", "LOG_FLOOR", "BOUND_TOL"]
+__all__ = ["Coord", "LOG_FLOOR", "BOUND_TOL", "Z_MAX"]
 
 #: Stands for a lower bound of 0 in the log reparametrisation.
 LOG_FLOOR = 1e-6
 #: A coordinate is "at a bound" when σ(z) is within this of 0 or 1 (log: of L₀/L₁).
 BOUND_TOL = 1e-6
-_Z_MAX = 30.0  # σ(±30) = 1 − 9e-14: z is clipped there (the bound to double precision)
+#: σ(±30) = 1 − 9e-14: z is clipped there (the bound to double precision).
+Z_MAX = 30.0
+_Z_MAX = Z_MAX
 
 
 def _sigmoid(z):

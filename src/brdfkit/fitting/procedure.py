@@ -18,33 +18,68 @@ optional ones that are None (e.g. no η: F = 1 stays so) and those in
 parameters per lobe. A parameter that changes nothing on the samples (e.g. an
 extinction coefficient without an η) is held and reported as ``inert``.
 Linear parameters (colour parameters the model is affine in, found
-numerically; see :mod:`brdfkit.fitting._problem`) are solved in closed form;
-the others ("shape") are optimised over bounded reparametrisations
+numerically for each candidate and then jointly — so a non-linear colour
+parameter such as η does not stop ρ_d, k_s from being linear; see
+:mod:`brdfkit.fitting._problem`) are solved in closed form; the others
+("shape") are optimised over bounded reparametrisations
 (:mod:`brdfkit.fitting._space`) with Nelder–Mead.
 
+Stages of ``procedure="staged"`` (= ``"auto"``, any model):
+
+(i) first guess and linear parameters: the width parameter (the model's
+    ``width_param``) from the measured peak's half-width β (via
+    ``width_from_beta``) and from the ladder β = 0.5°, 1°, …, 64°
+    (:data:`BETA_LADDER_DEG`), each with the linear parameters solved; the
+    width of least loss is kept (a measured peak alone can mislead: the clear
+    coat of two-layer-silver gives β → 0, s ≈ 10⁶, a local optimum on the
+    spike far from the broad lobe); the linear parameters solved there.
+(ii) search over the shape parameters on a coarser grid
+    (:data:`SEARCH_STRIDES`: ~2,700 samples, every θ_h and θ_d cell kept) with the
+    linear ones re-solved at every evaluation (variable projection), from
+    several starts: the guess; with free optional parameters (η), the same
+    model without them fitted first (recursively) and its optimum with those
+    parameters where they change the model least (the z of
+    :data:`NEUTRAL_Z` of least loss; for η: η → 0, F = 1 under total internal
+    reflection) — so a free optional parameter never makes the fit worse;
+    the declared defaults (an optional parameter declared None keeps its
+    value); ``n_starts − 2`` random ones (z of the guess plus N(0, 1), from
+    ``numpy.random.default_rng(seed)``). Every run is recorded; once two runs
+    reach the same loss (relative difference ≤ :data:`CONSENSUS`) the
+    remaining starts are recorded as skipped.
+(iii) polish on the fit's own samples from the best run: for l1, l2 and ngan
+    the shape with the linear parameters re-solved — variable projection is
+    exact for them (min over (shape, linear) = min over shape of the loss with
+    the linear part solved), so this is the joint optimum, the final L1 solve
+    run to convergence (:data:`IRLS_FINAL` steps); for log and perceptual
+    (linear part solved under L2) all free parameters jointly under the loss.
+
 ``procedure="nielsen"`` (Nielsen et al. 2015, "Fitting Results and
-Observations"): (i) the linear parameters (ρ_d and k_s) in closed form at
-the first guess; (ii) the shape parameters (s, α and η) with the linear ones
-held; (iii) the shape parameters with the linear parameters whose basis
-depends on the shape (k_s, not ρ_d: as the paper's stage (iii) frees s, α,
-k_s). ``procedure="staged"`` (any model): (i) as above; (ii) the shape
-parameters with the linear ones re-solved at every evaluation (variable
-projection: exact for l1/l2/ngan); (iii) all free parameters jointly under the
-loss. ``"auto"``: ``staged``. ``"direct"``: all free parameters jointly from
-the first guess (one stage, no linear solve: the plain approach, for
-comparison).
+Observations"): (i) as above (ρ_d and k_s); (ii) the shape parameters (s, α
+and η) with the linear ones solved at each start and then held; (iii) the
+shape parameters with the linear parameters whose basis depends on the shape
+(k_s, not ρ_d: as the paper's stage (iii) frees s, α, k_s), jointly under
+the loss. ``"direct"``: all free parameters jointly from the first guess (one
+stage, no linear solve: the plain approach, for comparison).
 
 A pumped model (no linear parameters: g depends on them) is started from the fit of its
 unpumped root (the root's own staged fit as stage (ii)), then stage (iii) optimises all its
 parameters jointly.
 
-Stage (ii) runs from several starts: the data-driven first guess (the width
-parameter from the measured peak's half-width β via the model's
-``width_from_beta``, the other shape parameters at their defaults), the
-declared defaults, and ``n_starts − 2`` random starts (z of the guess plus
-N(0, 1), from ``numpy.random.default_rng(seed)``). Every run is recorded; once
-two runs reach the same loss (relative difference ≤ :data:`CONSENSUS`) the
-remaining starts are recorded as skipped.
+Stopping and status: a Nelder–Mead run stops when its vertices' losses agree
+to :data:`FRTOL` of the loss after stage (i), or after :data:`STALL_EVALS`
+evaluations per coordinate without such an improvement (a flat valley, or a
+bound approached asymptotically in z); its stop is checked by one restart
+from the best point. The status is set by the last stage: MAX_EVALS when it
+reached its budget (a stage-(ii) search cut by its budget and then polished
+to the tolerance is recorded but converged). A polish cut by its budget is
+run once more (stage "iii'") with the coordinates at (or indistinguishable
+from) a bound set there and held: it converges where the crawl was towards a
+bound approached only asymptotically in z. Bounds are checked after the
+last stage: a coordinate at a bound, or one the loss cannot tell from a bound
+(moved there the loss rises by less than :data:`BOUND_LOSS_RTOL` relative;
+the bound is taken if the loss falls), is reported (``at_bounds``, status
+AT_BOUND, named in the message) — never a plain "converged". Every stage
+record lists the coordinates at a bound after it.
 
 The fit evaluates on one thread (``numba.set_num_threads(1)``, restored
 after): for ~15,000 pairs the parallel driver's thread wake-ups cost more
@@ -62,8 +97,8 @@ import numpy as np
 from scipy.optimize import minimize
 
 from brdfkit.errors import BrdfkitError, ParameterError
-from brdfkit.fitting._problem import Problem
-from brdfkit.fitting._space import Coord, as_vector, from_vector
+from brdfkit.fitting._problem import IRLS_ITERATIONS, Problem
+from brdfkit.fitting._space import Z_MAX, Coord, as_vector, from_vector
 from brdfkit.fitting.losses import LOSSES
 from brdfkit.fitting.samples import (
     ALBEDO_THETA_DEG,
@@ -87,12 +122,38 @@ STATUS_MESSAGES = {
     NONFINITE: "the fitted model is not finite on the samples",
 }
 #: Nelder–Mead stops when the losses at the simplex's vertices agree to this fraction of
-#: the first guess's loss (stage ii; stage iii, a polish from a stationary point, at
-#: FRTOL_POLISH). A criterion on the loss only: along flat directions (e.g. Lafortune's
-#: common scale of C_xy, C_z against rho_s) there is no parameter tolerance to reach.
-FRTOL, FRTOL_POLISH = 1e-6, 1e-5
+#: the loss after stage (i): FRTOL in the stage-(ii) search (the polish follows; the same
+#: order as CONSENSUS), FRTOL_POLISH in stage (iii). A criterion on the loss only: along
+#: flat directions (e.g. Lafortune's common scale of C_xy, C_z against rho_s) there is no
+#: parameter tolerance to reach.
+FRTOL, FRTOL_POLISH = 1e-4, 1e-5
+#: Restarts of a Nelder–Mead run from its best point (see _nelder_mead).
+NM_RESTARTS = 1
+#: A Nelder–Mead run stops after this many evaluations per coordinate without a
+#: significant improvement (see _nelder_mead).
+STALL_EVALS = 10
+#: Losses whose linear solve is exact (the L1 one by IRLS to convergence at the end).
+EXACT_PROJECTION = ("l1", "l2", "ngan")
+#: IRLS steps of the final L1 linear solve (the search's solves take IRLS_ITERATIONS,
+#: warm-started).
+IRLS_FINAL = 50
 #: Two stage-(ii) runs whose losses agree to this relative difference are one optimum.
-CONSENSUS = 1e-4
+CONSENSUS = 1e-3
+#: Stage (ii) searches on this coarser merging of MERL bins (θ_d, φ_d): every θ_h bin and
+#: the default's 10 θ_d cells kept (a Fresnel factor depends on θ_d; with 6 θ_d cells the
+#: search misjudged red-fabric2's η fit), 4 φ_d cells instead of 12: 2,676 samples instead
+#: of 8,134; stage (iii) polishes on the fit's own samples. The time per evaluation is then
+#: mostly fixed costs (model set-up, linear solves), so coarser cells gain little.
+SEARCH_STRIDES = (9, 45)
+#: Half-widths (degrees) scanned for the first guess of the width parameter (with the
+#: measured one): mirror-like to broad, a factor 2 apart.
+BETA_LADDER_DEG = (0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0)
+#: z of the optional parameters (e.g. η) tried at the nested model's optimum: the one
+#: where the loss is least (where the parameter changes the model least) starts stage (ii).
+NEUTRAL_Z = (-Z_MAX, -6.0, -2.0, 0.0, 2.0, 6.0, Z_MAX)
+#: A coordinate whose move to its bound changes the final loss by less than this relative
+#: amount is reported at that bound (the data cannot tell it from the bound).
+BOUND_LOSS_RTOL = 1e-4
 
 
 @dataclass(frozen=True, eq=False)
@@ -175,26 +236,57 @@ def _measured_half_width(target) -> float:
     return float(th[below[0]]) if below.size else math.pi / 4
 
 
+class _Stalled(Exception):
+    """Raised inside a Nelder–Mead run to stop it (see _nelder_mead)."""
+
+
 def _nelder_mead(fun, z0, steps, maxfev, scale, fatol):
     """Nelder–Mead from z0 with an initial simplex of the given steps; the loss is
-    divided by *scale* (the loss at the first guess, before any stage: a change below
-    FRTOL of it is negligible, also where the loss tends to 0 on exact data). A run that
-    reaches *maxfev* is restarted once from its best point with a fresh simplex (the
-    standard remedy for a collapsed simplex). Returns (z, value, n_evaluations,
-    hit_limit: the restart reached the limit too)."""
-    z0 = np.asarray(z0, dtype=np.float64)
-    n = z0.size
-    nfev = 0
-    for _ in range(2):  # a run that hits the limit is restarted once from its best point
-        simplex = np.vstack([z0] + [z0 + np.eye(n)[k] * steps[k] for k in range(n)])
-        res = minimize(lambda z: fun(z) / scale, z0, method="Nelder-Mead",
-                       options={"initial_simplex": simplex, "maxfev": maxfev, "xatol": math.inf,
-                                "fatol": fatol, "adaptive": n > 2})
-        nfev += int(res.nfev)
-        if res.nfev < maxfev:
+    divided by *scale* (a loss near the optimum: a change below *fatol* of it is
+    negligible, also where the loss tends to 0 on exact data).
+
+    A run stops when the losses at the simplex's vertices agree to *fatol*, or when
+    :data:`STALL_EVALS` × n evaluations in a row have not lowered the best loss by more
+    than *fatol* (stalled: crawling along a flat valley, e.g. Lafortune's common scale of
+    C_xy, C_z against ρ_s, or towards a bound approached only asymptotically in z; the
+    bound is then reported by _flat_to_bound). The stop is checked by restarting once from
+    the best point with a fresh simplex of half the steps (the standard remedy for a
+    collapsed simplex: along a curved valley, e.g. Nielsen's s against α, the simplex can
+    flatten and stop short). *maxfev* evaluations in all. Returns (z, value,
+    n_evaluations, hit_limit)."""
+    z = np.asarray(z0, dtype=np.float64)
+    n = z.size
+    st = {"n": 0, "best": math.inf, "z": z, "ref": math.inf, "since": 0}
+
+    def f(x):
+        v = fun(x) / scale
+        st["n"] += 1
+        if v < st["best"]:
+            st["best"], st["z"] = v, np.array(x, dtype=np.float64)
+        if v < st["ref"] - fatol:  # a significant improvement
+            st["ref"], st["since"] = v, 0
+        else:
+            st["since"] += 1
+            if st["since"] >= STALL_EVALS * n:
+                raise _Stalled
+        return v
+
+    for run in range(1 + NM_RESTARTS):
+        before = st["best"]
+        st["ref"], st["since"] = st["best"], 0
+        h = np.asarray(steps, dtype=np.float64) * (0.5 if run else 1.0)
+        zs = st["z"]
+        simplex = np.vstack([zs] + [zs + np.eye(n)[k] * h[k] for k in range(n)])
+        try:
+            with np.errstate(invalid="ignore"):  # inf − inf at refused vertices: not a stop
+                minimize(f, zs, method="Nelder-Mead",
+                         options={"initial_simplex": simplex, "maxfev": maxfev - st["n"],
+                                  "xatol": math.inf, "fatol": fatol, "adaptive": n > 2})
+        except _Stalled:
+            pass
+        if before - st["best"] <= fatol or st["n"] >= maxfev:
             break
-        z0 = res.x
-    return res.x, float(res.fun) * scale, nfev, res.nfev >= maxfev
+    return st["z"], st["best"] * scale, st["n"], st["n"] >= maxfev
 
 
 def _free_coords(model, fixed, C):
@@ -291,33 +383,43 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
     rng = np.random.default_rng(seed)
     C = int(target.n_channels or 1)
     prob = Problem(model, target, merl_samples(strides=strides, theta_max=theta_max), loss, C)
+    # stage (ii)'s search on a coarser grid (every θ_h bin kept); never finer than the fit's
+    coarse = tuple(max(int(a), b) for a, b in zip(strides, SEARCH_STRIDES, strict=True))
+    sp = (prob if coarse == tuple(int(a) for a in strides)
+          else Problem(model, target, merl_samples(strides=coarse, theta_max=theta_max), loss, C))
     coords, values = _free_coords(model, fixed, C)
     record = {"procedure": procedure, "loss": loss, "seed": seed,
-              "n_samples": len(prob.samples), "stages": [], "starts": []}
+              "n_samples": len(prob.samples), "n_samples_search": len(sp.samples),
+              "stages": [], "starts": []}
 
-    # data-driven first guess: the lobe width from the measured peak
+    def n_evals():
+        return prob.n_evals + (sp.n_evals if sp is not prob else 0)
+
+    # data-driven first guess: the lobe width from the measured peak (refined below by a
+    # scan of widths once the linear parameters are known)
     beta = _measured_half_width(target)
     record["measured_half_width_deg"] = math.degrees(beta)
     wp = model.width_param
-    if wp is not None and wp not in fixed and any(c.name == wp for c in coords):
-        # a pumped model's width parameter is its root's (the lobe keeps its shape)
-        root = model.root if isinstance(model, PumpedBRDF) else model
-        # β clamped to (0, π/2) open, as width_from_beta requires: 1e-4 rad is a
-        # mirror-like lobe, 1.4 rad (80°) a broad one
-        w0 = float(root.width_from_beta(min(max(beta, 1e-4), 1.4)))
-        values[wp] = np.full(np.shape(values[wp]), w0) if np.ndim(values[wp]) else w0
+    scan_width = wp is not None and wp not in fixed and any(c.name == wp for c in coords)
+    # a pumped model's width parameter is its root's (the lobe keeps its shape)
+    width_from_beta = (model.root if isinstance(model, PumpedBRDF) else model).width_from_beta
+    if scan_width:
+        values = _with_width(values, wp, width_from_beta, beta)
 
     # parameters that change nothing are held (and reported)
     inert = _inert(prob, coords, values)
     coords = [c for c in coords if c.name not in inert]
     record["inert"] = sorted(inert)
 
-    # linear colour parameters (variable projection)
+    # linear colour parameters (variable projection): each candidate tested alone, then the
+    # affine ones jointly (a colour parameter the model is not affine in, e.g. η, is a
+    # shape parameter and does not stop ρ_d, k_s from being solved in closed form)
     linear = []
     if procedure != "direct":
         cand = [(p.name, min(1.0, p.upper)) for p in model.params
                 if p.kind == "colour" and any(c.name == p.name for c in coords)]
-        if cand and prob.is_affine(values, cand, rng):
+        cand = [c for c in cand if prob.is_affine(values, [c], rng)]
+        if len(cand) == 1 or (cand and prob.is_affine(values, cand, rng)):
             linear = cand
     lin_names = [n for n, _ in linear]
     record["linear"] = lin_names
@@ -327,58 +429,92 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
     shape = [c for c in coords if c.name not in lin_names]
     if linear and shape:
         steps = np.array([c.step(_val(values, c)) for c in shape])
-        prob.find_static(values, linear, from_vector(as_vector(values, shape) + steps, shape,
-                                                     values))
+        moved = from_vector(as_vector(values, shape) + steps, shape, values)
+        for p in {id(prob): prob, id(sp): sp}.values():
+            p.find_static(values, linear, moved)
     record["static_bases"] = sorted(k or "f0" for k in prob.static)
 
-    def set_linear(vals, P):
+    def project(p, vals, iterations=IRLS_ITERATIONS):
+        """(*vals* with the linear parameters solved on problem *p*, the model's values
+        from the bases), or None when refused."""
+        got = p.bases(vals, linear) if linear else None
+        if got is None:
+            return None
+        f0, B = got
+        P = p.solve_linear(f0, B, lo, hi, loss, iterations=iterations)
         out = dict(vals)
         for k, n in enumerate(lin_names):
             out[n] = P[k].copy() if C > 1 else float(P[k, 0])
-        return out
+        # the model is affine in the linear parameters: its values from the bases
+        pred = f0.copy()
+        for k, Bk in enumerate(B):
+            pred += Bk * P[k][None, :]
+        return out, pred
 
-    def solve_at(vals, want_loss=False):
-        got = prob.bases(vals, linear)
+    def solve_at(p, vals, want_loss=False, iterations=IRLS_ITERATIONS):
+        """*vals* with the linear parameters solved on problem *p* (and its loss)."""
+        got = project(p, vals, iterations)
         if got is None:
             return (None, math.inf) if want_loss else None
-        f0, B = got
-        P = prob.solve_linear(f0, B, lo, hi, loss)
-        out = set_linear(vals, P)
+        out, pred = got
         if not want_loss:
             return out
         if loss == "perceptual":  # needs the model's albedo: evaluate it
-            return out, prob.loss_at(out)
-        # the model is affine in the linear parameters: its values from the bases
-        pred = f0 + sum(Bk * P[k][None, :] for k, Bk in enumerate(B))
-        return out, prob.loss_of(None, pred)
+            return out, p.loss_at(out)
+        return out, p.loss_of(None, pred)
 
-    def stage_record(name, params, n0, before, after, limit):
+    def search(p, free, v0, projecting, budget, steps, fatol):
+        """Minimise over the coordinates *free* from *v0* on problem *p*, the linear
+        parameters solved at every point (*projecting*) or held, by Nelder–Mead.
+        Returns (values, loss, evaluations, hit_limit)."""
+        def obj(z):
+            v = from_vector(z, free, v0)
+            return projected(p, v) if projecting else p.loss_at(v)
+        z, val, nfev, limit = _nelder_mead(obj, as_vector(v0, free), steps, budget, scale,
+                                           fatol)
+        end = from_vector(z, free, v0)
+        if projecting:
+            end = solve_at(p, end) or end
+        return end, val, nfev, limit
+
+    def projected(p, vals):
+        """Loss on *p* with the linear parameters solved (variable projection)."""
+        return solve_at(p, vals, want_loss=True)[1] if linear else p.loss_at(vals)
+
+    def stage_record(name, params, n0, before, after, limit, vals):
         record["stages"].append({"stage": name, "parameters": params,
-                                 "evaluations": prob.n_evals - n0, "loss_before": before,
-                                 "loss_after": after, "hit_limit": bool(limit)})
+                                 "evaluations": n_evals() - n0, "loss_before": before,
+                                 "loss_after": after, "hit_limit": bool(limit),
+                                 "at_bounds": [c.label for c in coords
+                                               if c.at_bound(_val(vals, c))]})
         if progress is not None:
-            progress(name, prob.n_evals, after)
+            progress(name, n_evals(), after)
 
     hit_limit = False
+    # ---------------------------------------------------------------- stage (i)
+    if linear:
+        n0 = n_evals()
+        before = prob.loss_at(values)
+        if scan_width:  # the width whose projected loss is least (module docstring)
+            values, record["width_scan"] = _scan_width(
+                values, wp, width_from_beta, beta, lambda v: projected(sp, v))
+        solved = solve_at(prob, values)
+        if solved is not None:
+            values = solved
+        stage_record("i: linear (closed form)" + (", width scanned" if scan_width else ""),
+                     lin_names, n0, before, prob.loss_at(values), False, values)
+
+    # the loss scale of the stopping rule: the loss after stage (i), near the optimum's
     scale = prob.loss_at(values)
     if not (math.isfinite(scale) and scale > 0.0):
         scale = 1.0  # a target the first guess already matches exactly, or a refused guess
-    # ---------------------------------------------------------------- stage (i)
-    if linear:
-        n0 = prob.n_evals
-        before = prob.loss_at(values)
-        solved = solve_at(values)
-        if solved is not None:
-            values = solved
-        stage_record("i: linear (closed form)", lin_names, n0, before, prob.loss_at(values),
-                     False)
 
     # a pumped model: its root fitted first (fast: linear parameters in closed form), the
     # root's optimum the start of the pumped model's joint stage (iii); rebuilding a pumped
     # model tabulates its albedo (~0.15 s), too slow for stage (ii)'s multi-start
     pumped_start = isinstance(model, PumpedBRDF) and procedure != "direct" and not linear
     if pumped_start:
-        n0 = prob.n_evals
+        n0 = n_evals()
         before = prob.loss_at(values)
         root_fit = _fit(model.root.with_params(**{k: v for k, v in values.items()
                                                   if k in model.root.values}),
@@ -391,55 +527,78 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
             values = start
         record["root_fit"] = {"convergence": root_fit.convergence, "value": root_fit.value}
         stage_record("ii: the unpumped root model (its own staged fit)",
-                     [c.label for c in coords], n0, before, min(before, after), False)
+                     [c.label for c in coords], n0, before, min(before, after), False, values)
 
     # ---------------------------------------------------------------- stage (ii)
     if procedure != "direct" and shape and not pumped_start:
-        n0 = prob.n_evals
+        n0 = n_evals()
         before = prob.loss_at(values)
-        budget = max(max_evals, 60 * len(shape))
+        budget = max(max_evals, 100 * len(shape))
         steps = np.array([c.step(_val(values, c)) for c in shape])
-        starts = [("guess", as_vector(values, shape))]
+        shape_names = {c.name for c in shape}
         defaults = dict(values)
         for p in model.params:
-            if p.name in {c.name for c in shape}:
+            # an optional parameter declared None (e.g. η: no Fresnel) keeps its value
+            if p.name in shape_names and p.default is not None:
                 defaults[p.name] = (np.broadcast_to(np.asarray(p.default, float),
                                                     np.shape(values[p.name])).copy()
                                     if np.ndim(values[p.name]) else float(p.default))
+        starts = [("guess", values)]
+        # the same model without its optional parameters (e.g. η: F = 1) fitted first, its
+        # optimum a start with those parameters where they change least: a free optional
+        # parameter never makes the fit worse than leaving it out (nested models)
+        nested = [p.name for p in model.params if p.optional and p.name in shape_names]
+        if nested:
+            inner = _fit(model.with_params(**{n: None for n in nested}), target, loss,
+                         procedure, {k: v for k, v in fixed.items() if k not in nested},
+                         theta_max, seed, n_starts, strides, max_evals)
+            record["nested"] = {"without": nested, "value": inner.value,
+                                "status": inner.status, "params": inner.params,
+                                "evaluations": inner.convergence["evaluations"]}
+            start = {**values, **{k: (np.asarray(v, dtype=np.float64)
+                                      if isinstance(v, list) else v)
+                                  for k, v in inner.params.items() if k not in nested}}
+            opt = [c for c in shape if c.name in nested]
+            best_z = min(NEUTRAL_Z, key=lambda zz: projected(
+                sp, from_vector(np.full(len(opt), zz), opt, start)))
+            starts.append(("nested: without " + ", ".join(nested),
+                           from_vector(np.full(len(opt), best_z), opt, start)))
         if n_starts >= 2:
-            starts.append(("defaults", as_vector(defaults, shape)))
+            starts.append(("defaults", defaults))
+        z_guess = as_vector(values, shape)
         for k in range(n_starts - 2):
-            starts.append((f"random {k + 1}", starts[0][1] + rng.normal(0.0, 1.0, len(shape))))
+            starts.append((f"random {k + 1}", from_vector(
+                z_guess + rng.normal(0.0, 1.0, len(shape)), shape, values)))
         best = None
         agree = 0
-        for label, z0 in starts[:n_starts]:
+        for label, v0 in starts[:n_starts + bool(nested)]:
             if agree >= 1:
                 # two runs from different starts reached the same loss (within CONSENSUS):
                 # the remaining starts are recorded as skipped
                 record["starts"].append({"start": label, "skipped": "consensus"})
                 continue
-            if procedure == "staged" and linear:
-                def obj(z):
-                    return solve_at(from_vector(z, shape, values), want_loss=True)[1]
-            else:
-                def obj(z):
-                    return prob.loss_at(from_vector(z, shape, values))
-            z, val, nfev, limit = _nelder_mead(obj, z0, steps, budget, scale, FRTOL)
-            end = from_vector(z, shape, values)
-            if procedure == "staged" and linear:
-                end = solve_at(end) or end
-            record["starts"].append({"start": label, "from": _jsonable(from_vector(
-                z0, shape, values), coords), "to": _jsonable(end, coords), "loss": val,
-                "evaluations": nfev, "hit_limit": bool(limit)})
+            if linear and procedure == "nielsen":
+                # Nielsen's (ii): the linear parameters solved at the start, then held
+                v0 = solve_at(sp, v0) or v0
+            end, val, nfev, limit = search(sp, shape, v0, linear and procedure != "nielsen",
+                                           budget, steps, FRTOL)
+            record["starts"].append({"start": label, "from": _jsonable(v0, coords),
+                                     "to": _jsonable(end, coords), "loss": val,
+                                     "evaluations": nfev, "hit_limit": bool(limit)})
             if best is not None and abs(val - best[0]) <= CONSENSUS * abs(best[0]):
                 agree += 1
             if best is None or val < best[0]:
                 best = (val, end, limit)
         values = best[1]
-        hit_limit |= best[2]
-        stage_record("ii: shape" + (" (linear re-solved)" if procedure == "staged" and linear
-                                    else ""), [c.label for c in shape], n0, before, best[0],
-                     best[2])
+        hit_limit = best[2]  # superseded by stage (iii)'s: the last stage decides the status
+        after = prob.loss_at(values)
+        if linear:  # the linear parameters re-solved on the fit's own samples
+            solved = solve_at(prob, values, want_loss=True)
+            if solved[0] is not None and solved[1] <= after:
+                values, after = solved
+        stage_record("ii: shape" + (" (linear re-solved)" if procedure != "nielsen" and linear
+                                    else "") + f" on {len(sp.samples)} samples",
+                     [c.label for c in shape], n0, before, after, best[2], values)
 
     # ---------------------------------------------------------------- stage (iii)
     if procedure == "nielsen" and linear:
@@ -448,21 +607,108 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         free3 = shape + [c for c in coords if c.name in moving]
     else:
         free3 = coords
+    # variable projection is exact for l1, l2, ngan: min over (shape, linear) of the loss
+    # is min over the shape of the loss with the linear parameters solved, so the staged
+    # procedure's joint stage (iii) is the shape polished with them re-solved
+    projected3 = bool(procedure == "staged" and linear and shape and loss in EXACT_PROJECTION)
+    if projected3:
+        free3 = shape
     if free3:
-        n0 = prob.n_evals
+        n0 = n_evals()
         before = prob.loss_at(values)
         # a tenth of stage (ii)'s steps: stage (iii) starts near a stationary point
         steps = 0.1 * np.array([c.step(_val(values, c)) for c in free3])
-        z, val, _, limit = _nelder_mead(lambda z: prob.loss_at(from_vector(z, free3, values)),
-                                        as_vector(values, free3), steps,
-                                        max(max_evals, 40 * len(free3)), scale, FRTOL_POLISH)
+        end, val, _, limit = search(prob, free3, values, projected3,
+                                    max(max_evals, 100 * len(free3)), steps, FRTOL_POLISH)
+        if projected3:  # the final linear solve to convergence (IRLS_FINAL steps for l1)
+            end = solve_at(prob, end, iterations=IRLS_FINAL) or end
+            val = prob.loss_at(end)
         if val <= before:
-            values = from_vector(z, free3, values)
-        hit_limit |= limit
+            values = end
+        # the final stage's stop decides: a stage-(ii) search cut by its budget and then
+        # polished here to the tolerance is a converged result (its limit stays recorded)
+        hit_limit = limit
         stage_record("iii: " + ("shape and shape-dependent linear" if procedure == "nielsen"
+                                else "shape, linear re-solved (= all jointly)" if projected3
                                 else "all"), [c.label for c in free3], n0, before,
-                     min(val, before), limit)
-    return _result(prob, target, values, coords, record, hit_limit, t_start)
+                     min(val, before), limit, values)
+    values, flat = _flat_to_bound(prob, values, coords)
+    if free3 and hit_limit:
+        # the polish was still crawling, typically towards a bound approached only
+        # asymptotically in z: the coordinates at (or indistinguishable from) a bound are
+        # set there and held, and the polish is run once more over the others
+        held = [c for c in free3 if c.label in flat or c.at_bound(_val(values, c))]
+        rest = [c for c in free3 if c not in held]
+        if held and rest:
+            n0 = n_evals()
+            before = prob.loss_at(values)
+            start = values
+            for c in held:
+                side = flat[c.label][0] if c.label in flat else c.at_bound(_val(values, c))
+                start = from_vector([Z_MAX if side == "upper" else -Z_MAX], [c], start)
+            steps = 0.1 * np.array([c.step(_val(start, c)) for c in rest])
+            end, val, _, limit = search(prob, rest, start, projected3,
+                                        max(max_evals, 100 * len(rest)), steps, FRTOL_POLISH)
+            if projected3:
+                end = solve_at(prob, end, iterations=IRLS_FINAL) or end
+                val = prob.loss_at(end)
+            if val <= before:
+                values, hit_limit = end, limit
+                values, flat = _flat_to_bound(prob, values, coords)
+            elif not limit:  # stopped by the tolerance without a gain: a converged point
+                hit_limit = False
+            stage_record("iii': polish with " + ", ".join(c.label for c in held)
+                         + " held at their bounds", [c.label for c in rest], n0, before,
+                         min(val, before), limit, values)
+    record["evaluations_search"] = sp.n_evals if sp is not prob else 0
+    return _result(prob, target, values, coords, record, hit_limit, t_start, flat, n_evals())
+
+
+def _with_width(values, wp, width_from_beta, beta):
+    """*values* with the width parameter set from half-width *beta* (radians)."""
+    # β clamped to (0, π/2) open, as width_from_beta requires: 1e-4 rad is a mirror-like
+    # lobe, 1.4 rad (80°) a broad one
+    w0 = float(width_from_beta(min(max(beta, 1e-4), 1.4)))
+    out = dict(values)
+    out[wp] = np.full(np.shape(values[wp]), w0) if np.ndim(values[wp]) else w0
+    return out
+
+
+def _scan_width(values, wp, width_from_beta, beta, loss_of):
+    """The first guess of the width: the measured half-width *beta* and the ladder
+    :data:`BETA_LADDER_DEG`, each with the linear parameters solved (*loss_of*); the one of
+    least loss. A measured peak can mislead (two-layer-silver: a mirror-like spike of its
+    clear coat on a broad lobe gives s ≈ 10⁶, a local optimum far from the broad lobe)."""
+    tried = []
+    for b in (beta, *np.radians(BETA_LADDER_DEG)):
+        v = _with_width(values, wp, width_from_beta, float(b))
+        tried.append((loss_of(v), math.degrees(float(b)), v))
+    best = min(tried, key=lambda t: t[0])
+    return best[2], [{"beta_deg": b, "loss": val} for val, b, _ in tried]
+
+
+def _flat_to_bound(prob, values, coords):
+    """Coordinates the loss cannot tell from a bound: moved to the bound (z = ±Z_MAX)
+    the loss rises by at most :data:`BOUND_LOSS_RTOL` relative (or falls: then the bound
+    is taken). Returns (values, {label: (side, bound, relative loss change)})."""
+    best = prob.loss_at(values)
+    flat = {}
+    if not math.isfinite(best):
+        return values, flat
+    for c in coords:
+        for side, z in (("lower", -Z_MAX), ("upper", Z_MAX)):
+            if c.transform == "identity" or (side == "upper" and math.isinf(c.upper)):
+                continue
+            if c.at_bound(_val(values, c)) == side:
+                continue  # already there (reported by the exact test)
+            moved = from_vector([z], [c], values)
+            lb = prob.loss_at(moved)
+            if lb <= best * (1.0 + BOUND_LOSS_RTOL):
+                flat[c.label] = (side, c.to_x(z), (lb - best) / best if best > 0 else 0.0)
+                if lb < best:
+                    values, best = moved, lb
+                break
+    return values, flat
 
 
 def _val(values, c):
@@ -498,7 +744,8 @@ def _shape_dependent(prob, linear) -> set:
     return {n for n, _ in linear if n not in prob.static}
 
 
-def _result(prob, target, values, coords, record, hit_limit, t_start) -> FitResult:
+def _result(prob, target, values, coords, record, hit_limit, t_start, flat,
+            evaluations) -> FitResult:
     m, pred = prob.predict(values)
     if m is None:  # unreachable: stage values come from evaluated, accepted models
         raise BrdfkitError("fit: the fitted parameters were refused by the model")
@@ -519,8 +766,14 @@ def _result(prob, target, values, coords, record, hit_limit, t_start) -> FitResu
         side = c.at_bound(_val(values, c))
         if side:
             at_bounds.append({"parameter": c.label, "bound": side,
-                              "value": c.lower if side == "lower" else c.upper})
-    record.update(evaluations=prob.n_evals, refused=prob.n_invalid,
+                              "value": c.lower if side == "lower" else c.upper,
+                              "fitted": _val(values, c)})
+        elif c.label in flat:  # the loss cannot tell it from its bound (_flat_to_bound)
+            side, _, change = flat[c.label]
+            at_bounds.append({"parameter": c.label, "bound": side,
+                              "value": c.lower if side == "lower" else c.upper,
+                              "fitted": _val(values, c), "loss_change_at_bound": change})
+    record.update(evaluations=evaluations, refused=prob.n_invalid,
                   time_s=time.perf_counter() - t_start, at_bounds=at_bounds)
     if not np.all(np.isfinite(pred)) or not math.isfinite(metrics[prob.loss]):
         status = 3
@@ -532,8 +785,10 @@ def _result(prob, target, values, coords, record, hit_limit, t_start) -> FitResu
         status = 0
     msg = STATUS_MESSAGES[status]
     if at_bounds:
-        msg += " (" + ", ".join(f"{b['parameter']} at its {b['bound']} bound {b['value']:g}"
-                                for b in at_bounds) + ")"
+        msg += " (" + ", ".join(
+            f"{b['parameter']} " + ("at" if "loss_change_at_bound" not in b else
+                                    f"= {b['fitted']:.4g}, indistinguishable from")
+            + f" its {b['bound']} bound {b['value']:g}" for b in at_bounds) + ")"
     d = m.to_dict()
     return FitResult(model=m, params=d["params"], loss=prob.loss, value=metrics[prob.loss],
                      metrics=metrics, theta_deg=np.asarray(ALBEDO_THETA_DEG), albedo_model=a_m,
