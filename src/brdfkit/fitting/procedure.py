@@ -36,7 +36,11 @@ comparison).
 
 A pumped model (no linear parameters: g depends on them) is started from the fit of its
 unpumped root (the root's own staged fit as stage (ii)), then stage (iii) optimises all its
-parameters jointly.
+parameters jointly. A one-times pumped model is evaluated during the fit through
+:func:`brdfkit.pumping.surrogate.surrogate` (albedo tables per shape parameter value,
+interpolated, linear parameters combined without a new table); the result, its metrics and
+albedos are the exact model's, and ``convergence["surrogate"]`` records the surrogate's loss
+at the result next to them.
 
 Stage (ii) runs from several starts: the data-driven first guess (the width
 parameter from the measured peak's half-width β via the model's
@@ -74,6 +78,7 @@ from brdfkit.fitting.samples import (
 )
 from brdfkit.models import BRDF
 from brdfkit.pumping import PumpedBRDF
+from brdfkit.pumping.surrogate import surrogate
 
 __all__ = ["fit", "FitResult", "PROCEDURES", "STATUS_MESSAGES"]
 
@@ -294,6 +299,12 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
     coords, values = _free_coords(model, fixed, C)
     record = {"procedure": procedure, "loss": loss, "seed": seed,
               "n_samples": len(prob.samples), "stages": [], "starts": []}
+    # a one-times pumped model is evaluated through its surrogate (tables per shape
+    # parameter, linear parameters combined: brdfkit.pumping.surrogate) until _result,
+    # which evaluates the exact model
+    fast = surrogate(model, [c.name for c in coords])
+    if fast is not None:
+        prob.model = fast
 
     # data-driven first guess: the lobe width from the measured peak
     beta = _measured_half_width(target)
@@ -462,6 +473,11 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         stage_record("iii: " + ("shape and shape-dependent linear" if procedure == "nielsen"
                                 else "all"), [c.label for c in free3], n0, before,
                      min(val, before), limit)
+    if fast is not None:
+        record["surrogate"] = {"linear": list(fast.linear), "shape": list(fast.shape),
+                               "loss": prob.loss_at(values), "tables_built": fast.n_tables,
+                               "table_time_s": fast.table_time_s}
+        prob.model = model  # the result: the exact pumped model
     return _result(prob, target, values, coords, record, hit_limit, t_start)
 
 
