@@ -40,7 +40,9 @@ parameters jointly. A one-times pumped model is evaluated during the fit through
 :func:`brdfkit.pumping.surrogate.surrogate` (albedo tables per shape parameter value,
 interpolated, linear parameters combined without a new table); the result, its metrics and
 albedos are the exact model's, and ``convergence["surrogate"]`` records the surrogate's loss
-at the result next to them.
+at the result next to them. Where the pumped model does not see a common scale of its linear
+parameters (g₁: f/g is homogeneous of degree 0 in them), one per channel is held at the
+root's value (``convergence["scale_held"]``; :mod:`brdfkit.fitting._pumped`).
 
 Stage (ii) runs from several starts: the data-driven first guess (the width
 parameter from the measured peak's half-width β via the model's
@@ -67,6 +69,7 @@ from scipy.optimize import minimize
 
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.fitting._problem import Problem
+from brdfkit.fitting._pumped import hold_scale
 from brdfkit.fitting._space import Coord, as_vector, from_vector
 from brdfkit.fitting.losses import LOSSES
 from brdfkit.fitting.samples import (
@@ -400,6 +403,12 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         after = prob.loss_at(start)
         if after <= before:
             values = start
+        # g1 pumping does not see a common scale of the linear parameters: held per channel
+        held = hold_scale(prob, values, coords, [p.name for p in model.params
+                                                 if p.kind == "colour"])
+        if held:
+            coords = [c for c in coords if c.label not in held]
+            record["scale_held"] = held
         record["root_fit"] = {"convergence": root_fit.convergence, "value": root_fit.value}
         stage_record("ii: the unpumped root model (its own staged fit)",
                      [c.label for c in coords], n0, before, min(before, after), False)
