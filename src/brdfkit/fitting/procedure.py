@@ -40,9 +40,11 @@ parameters jointly. A one-times pumped model is evaluated during the fit through
 :func:`brdfkit.pumping.surrogate.surrogate` (albedo tables per shape parameter value,
 interpolated, linear parameters combined without a new table); the result, its metrics and
 albedos are the exact model's, and ``convergence["surrogate"]`` records the surrogate's loss
-at the result next to them. Where the pumped model does not see a common scale of its linear
-parameters (g₁: f/g is homogeneous of degree 0 in them), one per channel is held at the
-root's value (``convergence["scale_held"]``; :mod:`brdfkit.fitting._pumped`).
+at the result next to them, and, evaluations being cheap, all parameters get one run with
+stage (ii)'s full steps before stage (iii)'s polish. Where the pumped model does not see a
+common scale of its linear parameters (g₁: f/g is homogeneous of degree 0 in them), one per
+channel is held at the root's value (``convergence["scale_held"]``;
+:mod:`brdfkit.fitting._pumped`).
 
 Stage (ii) runs from several starts: the data-driven first guess (the width
 parameter from the measured peak's half-width β via the model's
@@ -412,6 +414,21 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         record["root_fit"] = {"convergence": root_fit.convergence, "value": root_fit.value}
         stage_record("ii: the unpumped root model (its own staged fit)",
                      [c.label for c in coords], n0, before, min(before, after), False)
+        if fast is not None and coords:
+            # evaluations are cheap through the surrogate: one run with stage (ii)'s full
+            # steps before stage (iii)'s polish (which starts far from its optimum when the
+            # root's optimum was rejected above)
+            n0 = prob.n_evals
+            before = prob.loss_at(values)
+            z, val, _, limit = _nelder_mead(
+                lambda z: prob.loss_at(from_vector(z, coords, values)), as_vector(values, coords),
+                np.array([c.step(_val(values, c)) for c in coords]),
+                max(max_evals, 60 * len(coords)), scale, FRTOL)
+            if val <= before:
+                values = from_vector(z, coords, values)
+            hit_limit |= limit
+            stage_record("ii: all (pumped, full steps)", [c.label for c in coords], n0, before,
+                         min(val, before), limit)
 
     # ---------------------------------------------------------------- stage (ii)
     if procedure != "direct" and shape and not pumped_start:
