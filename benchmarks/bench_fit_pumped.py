@@ -13,7 +13,10 @@ procedure, default samples) in this process:
   run pays for its own tables as a fresh process would;
 - rebuild (before): the surrogate switched off, every evaluation builds
   ``pump(root.with_params(...))`` (albedo table with the engine, lookups), as
-  ``fit`` did before. Its time is split into model builds and evaluations.
+  ``fit`` did before; without the surrogate ``fit`` also skips the full-step run
+  before stage (iii) (too costly at ~0.5 s per evaluation), so this is the
+  procedure before this change except for the held scale (``scale_held``).
+  Times are split into model builds and evaluations.
   (On main before this change every build also compiled a new driver, 4-20 s
   each: that fit did not finish in 13 minutes; not repeated here.)
 
