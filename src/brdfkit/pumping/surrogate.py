@@ -42,9 +42,10 @@ Error: for modified Phong the surrogate's albedo is within
 :data:`SURROGATE_ALBEDO_TOL` (absolute) of Lewis's H_s computed by its own
 quadrature (``tests/test_pumping_surrogate.py``, n from 1.6 to 10⁵ between the
 nodes; measured at most 8.7e-6, at n = 1.6); interpolation error alone (exact
-node values, 60 random n in [0.5, 5e5]): 1.6e-6 at spacing 0.2, 8e-6 at 0.3. A fit records the surrogate's loss at its result
-next to the exact one (``FitResult.convergence["surrogate"]``); the result's
-model and metrics are the exact pumped model's.
+node values, 60 random n in [0.5, 5e5]): 1.6e-6 at spacing 0.2, 8e-6 at 0.3.
+A fit records the surrogate's loss at its result next to the exact one
+(``FitResult.convergence["surrogate"]``); the result's model and metrics are
+the exact pumped model's.
 
 The values are a pure function of the parameters (the caches only save
 work), so a fit through the surrogate gives the same result whatever was
