@@ -63,7 +63,15 @@ stage, no linear solve: the plain approach, for comparison).
 
 A pumped model (no linear parameters: g depends on them) is started from the fit of its
 unpumped root (the root's own staged fit as stage (ii)), then stage (iii) optimises all its
-parameters jointly.
+parameters jointly. A one-times pumped model is evaluated during the fit through
+:func:`brdfkit.pumping.surrogate.surrogate` (albedo tables per shape parameter value,
+interpolated, linear parameters combined without a new table); the result, its metrics and
+albedos are the exact model's, and ``convergence["surrogate"]`` records the surrogate's loss
+at the result next to them, and, evaluations being cheap, all parameters get one run with
+stage (ii)'s full steps before stage (iii)'s polish. Where the pumped model does not see a
+common scale of its linear parameters (g₁: f/g is homogeneous of degree 0 in them), one per
+channel is held at the root's value (``convergence["scale_held"]``;
+:mod:`brdfkit.fitting._pumped`).
 
 Stopping and status: a Nelder–Mead run stops when its vertices' losses agree
 to :data:`FRTOL` of the loss after stage (i), or after :data:`STALL_EVALS`
@@ -98,6 +106,7 @@ from scipy.optimize import minimize
 
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.fitting._problem import IRLS_ITERATIONS, Problem
+from brdfkit.fitting._pumped import hold_scale
 from brdfkit.fitting._space import Z_MAX, Coord, as_vector, from_vector
 from brdfkit.fitting.losses import LOSSES
 from brdfkit.fitting.samples import (
@@ -109,6 +118,7 @@ from brdfkit.fitting.samples import (
 )
 from brdfkit.models import BRDF
 from brdfkit.pumping import PumpedBRDF
+from brdfkit.pumping.surrogate import surrogate
 
 __all__ = ["fit", "FitResult", "PROCEDURES", "STATUS_MESSAGES"]
 
@@ -391,6 +401,13 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
     record = {"procedure": procedure, "loss": loss, "seed": seed,
               "n_samples": len(prob.samples), "n_samples_search": len(sp.samples),
               "stages": [], "starts": []}
+    # a one-times pumped model is evaluated through its surrogate (tables per shape
+    # parameter, linear parameters combined: brdfkit.pumping.surrogate) until _result,
+    # which evaluates the exact model
+    fast = surrogate(model, [c.name for c in coords])
+    if fast is not None:
+        prob.model = fast
+        sp.model = fast
 
     def n_evals():
         return prob.n_evals + (sp.n_evals if sp is not prob else 0)
@@ -525,9 +542,30 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         after = prob.loss_at(start)
         if after <= before:
             values = start
+        # g1 pumping does not see a common scale of the linear parameters: held per channel
+        held = hold_scale(prob, values, coords, [p.name for p in model.params
+                                                 if p.kind == "colour"])
+        if held:
+            coords = [c for c in coords if c.label not in held]
+            record["scale_held"] = held
         record["root_fit"] = {"convergence": root_fit.convergence, "value": root_fit.value}
         stage_record("ii: the unpumped root model (its own staged fit)",
                      [c.label for c in coords], n0, before, min(before, after), False, values)
+        if fast is not None and coords:
+            # evaluations are cheap through the surrogate: one run with stage (ii)'s full
+            # steps before stage (iii)'s polish (which starts far from its optimum when the
+            # root's optimum was rejected above)
+            n0 = n_evals()
+            before = prob.loss_at(values)
+            z, val, _, limit = _nelder_mead(
+                lambda z: prob.loss_at(from_vector(z, coords, values)), as_vector(values, coords),
+                np.array([c.step(_val(values, c)) for c in coords]),
+                max(max_evals, 60 * len(coords)), scale, FRTOL)
+            if val <= before:
+                values = from_vector(z, coords, values)
+            hit_limit |= limit
+            stage_record("ii: all (pumped, full steps)", [c.label for c in coords], n0, before,
+                         min(val, before), limit, values)
 
     # ---------------------------------------------------------------- stage (ii)
     if procedure != "direct" and shape and not pumped_start:
@@ -661,6 +699,11 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
                          + " held at their bounds", [c.label for c in rest], n0, before,
                          min(val, before), limit, values)
     record["evaluations_search"] = sp.n_evals if sp is not prob else 0
+    if fast is not None:
+        record["surrogate"] = {"linear": list(fast.linear), "shape": list(fast.shape),
+                               "loss": prob.loss_at(values), "tables_built": fast.n_tables,
+                               "table_time_s": fast.table_time_s}
+        prob.model = model  # the result: the exact pumped model
     return _result(prob, target, values, coords, record, hit_limit, t_start, flat, n_evals())
 
 

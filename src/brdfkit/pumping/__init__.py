@@ -24,6 +24,10 @@ Modules
 - :mod:`brdfkit.pumping.operator` — :func:`pump`, :class:`PumpedBRDF`, g validation.
 - :mod:`brdfkit.pumping.table` — :class:`AlbedoTable`, :func:`build_albedo_table`.
 - :mod:`brdfkit.pumping.kernels` — the compiled chain and stage kernels.
+- :mod:`brdfkit.pumping.surrogate` — :func:`~brdfkit.pumping.surrogate.surrogate`, the fast
+  stand-in for a one-times pumped model that a fit evaluates (basis albedo tables per
+  shape-parameter node, linear parameters combined; ``docs/pumping.md``, "Fitting a pumped
+  model").
 - :mod:`brdfkit.tables` (shared with the models) — the grid variable and the
   compiled :class:`~brdfkit.tables.Lookup` the kernels read.
 

@@ -124,14 +124,14 @@ class AlbedoTable:
         return out if self.coloured else out[..., 0]
 
 
-def _engine(model) -> Callable:
-    """The albedo engine as ``theta -> (T,) or (T, C)`` for *model*."""
+def _engine(model, tol: float = ENGINE_TOL) -> Callable:
+    """The albedo engine as ``theta -> (T,) or (T, C)`` for *model*, to accuracy *tol*."""
     from brdfkit.analysis import albedo  # the engine is a higher layer: imported when used
 
     def run(theta: np.ndarray) -> np.ndarray:
         # a model without a compiled kernel (custom g) is integrated through its eval, in
         # the frame of its lobes
-        parts = [np.asarray(albedo(model, theta[i:i + ENGINE_CHUNK], tol=ENGINE_TOL).albedo,
+        parts = [np.asarray(albedo(model, theta[i:i + ENGINE_CHUNK], tol=tol).albedo,
                             dtype=np.float64) for i in range(0, len(theta), ENGINE_CHUNK)]
         return np.concatenate(parts, axis=0)
 
@@ -139,7 +139,8 @@ def _engine(model) -> Callable:
 
 
 def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
-                       nn_max: int = 8192, kinks_mu=None) -> AlbedoTable:
+                       nn_max: int = 8192, kinks_mu=None,
+                       engine_tol: float = ENGINE_TOL) -> AlbedoTable:
     """Tabulate the albedo of *model* to interpolation tolerance *tol*.
 
     Parameters
@@ -156,6 +157,10 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
         cos θ where the albedo has a kink; default ``model.albedo_kink_mus``
         (pumped models declare them). The table is split there into pieces
         with their own splines.
+    engine_tol : float, keyword-only
+        Accuracy asked of the albedo engine (default :data:`ENGINE_TOL`; the margin
+        still assumes :data:`ENGINE_ERR`, so a looser value is for approximate
+        tables only, e.g. :mod:`brdfkit.pumping.surrogate`'s).
 
     Returns
     -------
@@ -172,7 +177,10 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
             f"build_albedo_table: model must be a brdfkit model (BRDF); got {type(model)!r}")
     if not (isinstance(tol, float | int) and 0.0 < tol < 1.0):
         raise ParameterError(f"build_albedo_table: tol must lie in (0, 1); got {tol!r}")
-    run = _engine(model)
+    if not (isinstance(engine_tol, float | int) and 0.0 < engine_tol < 1.0):
+        raise ParameterError(
+            f"build_albedo_table: engine_tol must lie in (0, 1); got {engine_tol!r}")
+    run = _engine(model, engine_tol)
     s_top = float(w_of_mu(math.cos(THETA_TOP)))
     if kinks_mu is None:
         kinks_mu = model.albedo_kink_mus
