@@ -396,7 +396,9 @@ def fit_row(job: Job) -> dict:
     result into one row: status (ok / not-converged), the loss value, the parameters (JSON,
     ready for ``-p``), every metric (``metric_<name>``), the worst albedo relative error,
     the evaluations and the seconds. ``job.options`` may hold ``pump``, ``times``,
-    ``seed`` and ``theta_max_deg``."""
+    ``seed``, ``theta_max_deg``, ``params`` (a JSON object of starting values, e.g.
+    ``{"eta": 1.5}`` to fit an optional index η that is None by default) and ``fixed``
+    (a JSON list of parameter names held at those values, e.g. ``["alpha"]``)."""
     import json
     import math
 
@@ -408,15 +410,19 @@ def fit_row(job: Job) -> dict:
 
     opts = dict(job.options)
     m = build_spec(job.model)
+    if opts.get("params"):
+        m = m.with_params(**json.loads(opts["params"]))  # validated by the model
+    fixed = {k: m.values[k] for k in json.loads(opts.get("fixed") or "[]")}
     if opts.get("pump"):
         m = pump(m, g=opts["pump"], times=int(opts.get("times", 1)))
     target = build_spec(job.target)
     theta_max = opts.get("theta_max_deg")
     t0 = time.perf_counter()
     r = fit(m, target, loss=job.loss, procedure=job.procedure, seed=int(opts.get("seed", 0)),
+            fixed=fixed or None,
             theta_max=None if theta_max is None else math.radians(float(theta_max)))
     d = r.to_dict()
-    row = {"status": STATUS_OK if r.success else STATUS_NOT_CONVERGED,
+    row = {"status": STATUS_OK if r.success else STATUS_NOT_CONVERGED, "fit_status": r.status,
            "value": r.value, "params": json.dumps(d["params"], sort_keys=True)}
     row.update({f"metric_{k}": v for k, v in sorted(r.metrics.items())})
     rel = np.asarray(r.albedo_rel_error, dtype=np.float64)
