@@ -142,7 +142,8 @@ class StudyBatch:
 
 
 def study_batches(materials, *, parts=PARTS, ngan_names=None) -> list[StudyBatch]:
-    """The batches of the chosen *parts* over *materials* (specs like ``merl:nickel``).
+    """The batches of the chosen *parts* over *materials* (specs like ``merl:nickel``), in
+    the order the parts are given.
 
     *ngan_names* (names in Ngan's table) restrict the anchors part; None: no restriction.
     """
@@ -161,9 +162,10 @@ def study_batches(materials, *, parts=PARTS, ngan_names=None) -> list[StudyBatch
                                       "nielsen", materials, {**params, "eta": ETA0}, fixed))
     if "neumann" in parts:
         metals = tuple(m for m in materials if is_metal(m))
-        for loss in ("perceptual", "l2"):
+        for loss in ("perceptual", "l2"):  # the plain fits first: the pumped ones are slow
             out.append(StudyBatch("neumann", f"phong-{loss}", "modified Phong",
                                   "modified-phong", loss, "auto", metals))
+        for loss in ("perceptual", "l2"):
             out.append(StudyBatch("neumann", f"pumped-phong-{loss}", "pumped modified Phong",
                                   "modified-phong", loss, "auto", metals, pump=True))
     if "anchors" in parts:
