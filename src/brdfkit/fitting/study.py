@@ -174,7 +174,7 @@ def study_batches(materials, *, parts=PARTS, ngan_names=None) -> list[StudyBatch
                         if names is None or m.rsplit(":", 1)[-1] in names)
         out.append(StudyBatch("anchors", "lafortune-ngan", "Lafortune (one lobe)", "lafortune",
                               "ngan", "auto", targets))
-    return out
+    return sorted(out, key=lambda b: list(parts).index(b.part))  # stable within a part
 
 
 def run_study(directory, *, materials, parts=PARTS, workers: int = 1, ngan_csv=None,

@@ -81,9 +81,14 @@ def nielsen_table(study: dict, loss: str = "l1") -> list[dict]:
             row[v] = _f(fits[v][t][f"metric_{loss}"]) if t in fits[v] else math.nan
         vals = {v: row[v] for v in NIELSEN_VARIANTS if math.isfinite(row[v])}
         row["best"] = min(vals, key=vals.get) if vals else ""
-        # a tie: the runner-up within BETTER_MARGIN of the best (no model fits better)
-        ranked = sorted(vals.values())
-        row["tie"] = len(ranked) > 1 and ranked[1] <= (1 + BETTER_MARGIN) * ranked[0]
+        # Phong-like or Blinn–Phong-like: one below the other by more than BETTER_MARGIN,
+        # else a tie (the data do not tell the two lobes apart)
+        p, b = row["phong"], row["blinn-phong"]
+        m = 1 - BETTER_MARGIN
+        row["kind"] = "Phong" if p < m * b else "Blinn–Phong" if b < m * p else "tie"
+        row["tie"] = row["kind"] == "tie"
+        # the α-mix's gain over the better of the two (< 0: the optimiser missed a nested fit)
+        row["gain"] = 1.0 - row["alpha-mix"] / min(p, b)
         row["alpha"] = (_params(fits["alpha-mix"][t]).get("alpha", math.nan)
                         if t in fits["alpha-mix"] else math.nan)
         out.append(row)
@@ -246,6 +251,9 @@ def _alpha_figure(study, path):
         ax.hist(a, bins=bins, histtype="step" if loss == "l2" else "stepfilled",
                 alpha=1.0 if loss == "l2" else 0.5, color=colour, lw=1.5,
                 label=f"{loss.upper()} fits ({len(a)})")
+    from matplotlib.ticker import MaxNLocator
+
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("α of the α-mix (0: Phong, 1: Blinn–Phong)")
     ax.set_ylabel("materials")
     ax.set_xlim(0.0, 1.0)
@@ -420,21 +428,28 @@ def write_report(directory, *, out="docs/fitting-study.md", figures="docs/figure
         for r in t1:
             cells = [(_num(r[v]) if v != r["best"] else f"**{_num(r[v])}**")
                      for v in NIELSEN_VARIANTS]
-            best = VARIANT_LABEL.get(r["best"], "") + (" (tie < 1 %)" if r["tie"] else "")
-            rows.append([_name(r["target"]), *cells, best,
+            rows.append([_name(r["target"]), *cells, r["kind"], _num(100 * r["gain"], ".2f"),
                          _num(r["alpha"], ".3f"),
                          _num(t2.get(r["target"], {}).get("alpha", math.nan), ".3f")])
-        L += _table(["material", "L1 Phong", "L1 Blinn–Phong", "L1 α-mix", "best", "α (L1)",
-                     "α (L2)"], rows)
+        L += _table(["material", "L1 Phong", "L1 Blinn–Phong", "L1 α-mix",
+                     "Phong vs Blinn–Phong (> 1 %)", "α-mix gain (%)", "α (L1)", "α (L2)"],
+                    rows)
         cnt = Counter(r["best"] for r in t1 if r["best"])
-        clear = Counter(r["best"] for r in t1 if r["best"] and not r["tie"])
+        kinds = Counter(r["kind"] for r in t1)
         L += ["", "Lowest L1 per material: " + ", ".join(
             f"{VARIANT_LABEL[v]} {cnt.get(v, 0)}" for v in NIELSEN_VARIANTS)
-            + "; by more than 1 % over the runner-up: " + ", ".join(
-            f"{VARIANT_LABEL[v]} {clear.get(v, 0)}" for v in NIELSEN_VARIANTS)
-            + f"; ties {sum(r['tie'] for r in t1)}.", ""]
+            + ". Phong below Blinn–Phong by more than 1 %: " + str(kinds.get("Phong", 0))
+            + "; Blinn–Phong below Phong by more than 1 %: " + str(kinds.get("Blinn–Phong", 0))
+            + f"; ties: {kinds.get('tie', 0)}. α-mix gain: 1 − L1(α-mix) / min(L1 Phong, L1 "
+            "Blinn–Phong); it nests both (α = 0, 1), so a negative gain is an optimiser "
+            "failure.", ""]
         p = _alpha_figure(study, os.path.join(figures, "alpha-histogram.png"))
-        L += [f"![α of the α-mix fits]({rel}/{os.path.basename(p)})", ""]
+        ties = [r for r in t1 if r["tie"]]
+        L += [f"![α of the α-mix fits]({rel}/{os.path.basename(p)})", "",
+              f"Where Phong and Blinn–Phong tie (L1 within 1 %: {len(ties)} of {len(t1)} "
+              "materials" + (": " + ", ".join(_name(r["target"]) for r in ties) if ties
+                             else "") + "), the data do not determine α: its value there "
+              "says nothing about the material.", ""]
         pos = lobe_positions(study)
         if pos:
             L += ["### L1 vs L2: where the fitted lobe sits", "",
