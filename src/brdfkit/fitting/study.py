@@ -200,10 +200,10 @@ def run_study(directory, *, materials, parts=PARTS, workers: int = 1, ngan_csv=N
             os.makedirs(os.path.dirname(b.derived_path(directory)), exist_ok=True)
             reports.append(run_batch(derived_jobs(b, directory), out=b.derived_path(directory),
                                      run_job=derived_row, workers=workers, progress=progress))
-    if ngan is not None:
-        b = study_batches(materials, parts=("anchors",), ngan_names=ngan)[0]
-        rows = ngan_anchor_rows(read_rows(b.path(directory)), ngan)
-        _write_csv(os.path.join(directory, "anchors", "ngan-comparison.csv"), rows)
+        if b.part == "anchors":  # theirs on the same surrogates, as soon as ours are there
+            rows = ngan_anchor_rows(read_rows(b.path(directory)), ngan)
+            if rows:
+                _write_csv(os.path.join(directory, "anchors", "ngan-comparison.csv"), rows)
     return reports
 
 

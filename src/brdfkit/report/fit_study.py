@@ -288,8 +288,9 @@ def _fig1_figure(study, path, theta_i=(30.0, 60.0)):
                     label="L2 fit")
             ax.set_yscale("log")
             top = float(np.nanmax(y))
-            # log axis from 1e-3 of the measured peak: the base of the lobe stays visible
-            ax.set_ylim(top * 1e-3, top * 3.0)
+            # log axis down to 1e-3 of the measured peak (the base of the lobe stays
+            # visible), or to half the measured minimum when that is higher (flat materials)
+            ax.set_ylim(max(top * 1e-3, 0.5 * float(np.nanmin(y))), top * 3.0)
             ax.axvline(ti, color="0.7", lw=0.6)
             ax.set_title(f"{_name(t)}, θ_i = {ti:g}°", fontsize=9)
             if i == 1:
@@ -493,6 +494,14 @@ def write_report(directory, *, out="docs/fitting-study.md", figures="docs/figure
         p = _neumann_figure(study, os.path.join(figures, "neumann-errors.png"))
         if p:
             L += ["", f"![perceptual vs L2 errors]({rel}/{os.path.basename(p)})"]
+        per = [r.get("derived") for k, rr in neu if k[1].endswith("-perceptual") for r in rr
+               if _ok(r) and r.get("derived")]
+        if per:
+            dom = sum(_f(d["e_point"]) > _f(d["e_albedo"]) for d in per)
+            L += ["", f"In {dom} of {len(per)} perceptual fits the point-light error exceeds "
+                  "the albedo error; where it does, the loss's smooth maximum (power mean, "
+                  "p = 8) is set by the point-light term, and the fit trades albedo accuracy "
+                  "for it — the perceptual fit's albedo error can then exceed the L2 fit's."]
         L += [""]
     # ------------------------------------------------------------------ anchors
     comp = os.path.join(os.fspath(directory), "anchors", "ngan-comparison.csv")
@@ -544,9 +553,10 @@ def write_report(directory, *, out="docs/fitting-study.md", figures="docs/figure
     if tim:
         full = _full_counts(ngan_names)
         L += ["## Timings and the predicted full-study time", "",
-              "Seconds per fit (one process; the machine: 2 cores shared with other jobs) and "
-              "per derived row (the check of the fitted model dominates). Predicted: median "
-              "× the full study's fits of that batch ÷ 2 workers.", ""]
+              "Wall seconds per fit inside one worker, measured while a second worker (and "
+              "other jobs: 2 cores shared, load ≈ 5) ran, and per derived row (the check of "
+              "the fitted model dominates). Predicted: (median per fit + median per derived "
+              "row) × the full study's fits of that batch ÷ 2 workers.", ""]
         rows, total = [], 0.0
         for t in tim:
             nf = full[t["part"]]
