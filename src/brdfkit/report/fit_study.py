@@ -200,7 +200,9 @@ def _neumann_claims(study) -> list[dict]:
                     "relative errors, point light and sky light, minimised together) gives "
                     "smaller maximal relative errors than least squares", "test": "max(e_point,"
                     " e_albedo) of the perceptual fit below that of the L2 fit", "verdict":
-                    verdict, "evidence": f"{len(won)} of {len(pairs)} (model, metal) pairs."})
+                    verdict, "evidence": f"{len(won)} of {len(pairs)} (model, metal) pairs: "
+                    + ", ".join(f"{_name(t)} ({'pumped ' if m != 'phong' else ''}Phong) "
+                                f"{a:.3g} vs {b:.3g}" for m, t, a, b in pairs) + "."})
     rows = []
     for loss in ("perceptual", "l2"):
         plain = _by_target(study.get(("neumann", f"phong-{loss}"), []))
@@ -353,8 +355,19 @@ def _num(x, fmt=".4g") -> str:
 
 def _table(header, rows) -> list[str]:
     out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    out += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+    # a "|" inside a cell (|ln x|) would end the cell: escaped
+    out += ["| " + " | ".join(str(c).replace("|", "\\|") for c in r) + " |" for r in rows]
     return out
+
+
+def _anchor_rows(directory) -> list[dict]:
+    import csv
+
+    comp = os.path.join(os.fspath(directory), "anchors", "ngan-comparison.csv")
+    if not os.path.exists(comp):
+        return []
+    with open(comp, newline="", encoding="utf-8") as fh:
+        return list(csv.DictReader(fh))
 
 
 def _materials(study) -> list[str]:
@@ -412,7 +425,17 @@ def write_report(directory, *, out="docs/fitting-study.md", figures="docs/figure
           "cause as much as the model.", ""]
     # ------------------------------------------------------------------ verdicts
     L += ["## The claims and the verdicts", ""]
+    arows = _anchor_rows(directory)
     cl = claims(study)
+    if arows:
+        good = [r for r in arows if _f(r["ratio"]) <= 1.0]
+        cl.append({"paper": "Ngan 2005 (issue 10 §5)", "claim": "our Lafortune fits are at "
+                   "least as good as Ngan et al.'s published ones under their own metric",
+                   "test": "ours / theirs ≤ 1 on every material (same surrogate, loss ngan)",
+                   "verdict": "supported" if len(good) == len(arows) else "not supported",
+                   "evidence": f"{len(good)} of {len(arows)} materials; ratios "
+                   + ", ".join(f"{_name(r['target'])} {_f(r['ratio']):.3f}" for r in arows)
+                   + f" (their table read as '{arows[0]['convention']}')."})
     L += _table(["paper", "claim", "test", "verdict", "evidence"],
                 [(c["paper"], c["claim"], c["test"], f"**{c['verdict']}**", c["evidence"])
                  for c in cl])
@@ -504,30 +527,27 @@ def write_report(directory, *, out="docs/fitting-study.md", figures="docs/figure
                   "for it — the perceptual fit's albedo error can then exceed the L2 fit's."]
         L += [""]
     # ------------------------------------------------------------------ anchors
-    comp = os.path.join(os.fspath(directory), "anchors", "ngan-comparison.csv")
-    if os.path.exists(comp):
-        import csv
-
-        with open(comp, newline="", encoding="utf-8") as fh:
-            arows = list(csv.DictReader(fh))
-        if arows:
-            conv = arows[0]["convention"]
-            L += ["## Anchors: our Lafortune fits vs Ngan et al. 2005's published parameters",
-                  "", "Both evaluated on the same surrogate under Ngan's metric (loss `ngan`: "
-                  "cosine-weighted RMS over θ_i, θ_o ≤ 80°). Ngan's table is read at run time "
-                  "(GPL; never copied), G and B × 1.15, 1.66 (SOURCES.md §6). How the table's "
-                  "unit (C_xy, C_z) enter the lobe is not stated; the reading used is the one "
-                  f"with the smallest median metric over these materials (most favourable to "
-                  f"their parameters): **{conv}**. Ratio ≤ 1: ours at least as good.", ""]
-            L += _table(["material", "ours", "theirs", "ratio",
-                         *[f"theirs ({c})" for c in NGAN_CONVENTIONS]],
-                        [[_name(r["target"]), _num(_f(r["ours"])), _num(_f(r["theirs"])),
-                          _num(_f(r["ratio"]), ".3f"),
-                          *[_num(_f(r[f"theirs_{c}"])) for c in NGAN_CONVENTIONS]]
-                         for r in arows])
-            good = sum(_f(r["ratio"]) <= 1.0 for r in arows)
-            L += ["", f"Ours at least as good on {good} of {len(arows)} materials "
-                  f"({'every one' if good == len(arows) else 'not every one'}).", ""]
+    if arows:
+        conv = arows[0]["convention"]
+        L += ["## Anchors: our Lafortune fits vs Ngan et al. 2005's published parameters",
+              "", "Both evaluated on the same surrogate under Ngan's metric (loss `ngan`: "
+              "cosine-weighted RMS over θ_i, θ_o ≤ 80°). Ngan's table is read at run time "
+              "(GPL; never copied), G and B × 1.15, 1.66 (SOURCES.md §6). How the table's "
+              "unit (C_xy, C_z) enter the lobe is not stated. Three readings: *as-printed* "
+              "ρ_s (C_xy (u_x v_x + u_y v_y) + C_z u_z v_z)ⁿ; *peak-one* (C_xy, C_z) divided "
+              "by max(|C_xy|, |C_z|); *normalised* peak-one with ρ_s·(n + 2)/(2π). The "
+              "reading used is the one "
+              f"with the smallest median metric over these materials (most favourable to "
+              f"their parameters): **{conv}**. Ratio ≤ 1: ours at least as good.", ""]
+        L += _table(["material", "ours", "theirs", "ratio",
+                     *[f"theirs ({c})" for c in NGAN_CONVENTIONS]],
+                    [[_name(r["target"]), _num(_f(r["ours"])), _num(_f(r["theirs"])),
+                      _num(_f(r["ratio"]), ".3f"),
+                      *[_num(_f(r[f"theirs_{c}"])) for c in NGAN_CONVENTIONS]]
+                     for r in arows])
+        good = sum(_f(r["ratio"]) <= 1.0 for r in arows)
+        L += ["", f"Ours at least as good on {good} of {len(arows)} materials "
+              f"({'every one' if good == len(arows) else 'not every one'}).", ""]
     # ------------------------------------------------------------------ plausibility
     L += ["## Plausibility of the fitted models and convergence", "",
           "Every fitted model through `brdfkit check` (`brdfkit.analysis.plausibility.check`, "
@@ -576,15 +596,25 @@ def write_report(directory, *, out="docs/fitting-study.md", figures="docs/figure
               f"by these medians it takes {l1:.0f} min (all six Nielsen batches, L1 and L2: "
               f"{allp:.0f} min; both without the derived rows).", ""]
     # ------------------------------------------------------------------ commands
-    L += ["## Remake", "", "```bash"]
-    L += commands or [
-        "# fits and derived rows (resumable: re-run to continue; delete study/ to start "
-        "afresh)",
-        "PYTHONPATH=src python scripts/fit_study.py run --dir study --materials merl:all "
-        "--workers 2 --ngan ../shared/data/measured/merl_fits_lafortune_ngan2005.csv",
-        "# this report and docs/figures/study/",
-        "PYTHONPATH=src python scripts/fit_study.py report --dir study",
-    ]
+    ngan_arg = "--ngan ../shared/data/measured/merl_fits_lafortune_ngan2005.csv"
+    here = os.path.relpath(os.fspath(directory))
+    L += ["## Remake", "", "From the repository root (Ngan's table is read from `../shared/`;"
+          " `--ngan PATH` or `BRDFKIT_NGAN_CSV` point elsewhere). Fits and derived rows are "
+          "resumable: re-run the same command to continue; delete the directory (or one "
+          "part's folder and its `derived/` files) to refit after a change of the fitting "
+          "code.", "", "```bash"]
+    if commands:
+        L += list(commands)
+    else:
+        if n < FULL_MATERIALS:
+            L += ["# this subset run",
+                  f"PYTHONPATH=src python scripts/fit_study.py run --dir {here} --materials "
+                  + ",".join(mats) + f" --workers 2 {ngan_arg}",
+                  f"PYTHONPATH=src python scripts/fit_study.py report --dir {here}", ""]
+        L += ["# the full study (every MERL material)",
+              f"PYTHONPATH=src python scripts/fit_study.py run --dir study --materials merl:all "
+              f"--workers 2 {ngan_arg}",
+              "PYTHONPATH=src python scripts/fit_study.py report --dir study"]
     L += ["```", ""]
     text = "\n".join(L)
     write_atomic(out, lambda fh: fh.write(text.encode("utf-8")))
