@@ -31,6 +31,7 @@ from brdfkit.fitting.study import (
     in_plane_slice,
     is_metal,
     read_study,
+    study_batches,
 )
 
 __all__ = ["write_report", "claims", "nielsen_table", "FULL_MATERIALS"]
@@ -587,6 +588,12 @@ def write_report(directory, *, out="docs/fitting-study.md", figures="docs/figure
                          _num(t["derived_median"], ".1f"), nf, _num(pred / 60.0, ".1f")])
         L += _table(["batch", "fits here", "median s/fit", "mean s/fit", "median s/derived",
                      "fits in full study", "predicted min (--workers 2)"], rows)
+        timed = {t["batch"] for t in tim}
+        missing = [f"{b.part}/{b.name}" for b in study_batches(mats, ngan_names=ngan_names)
+                   if b.targets and f"{b.part}/{b.name}" not in timed]
+        if missing:
+            L += ["", "**Not timed** (no finished fit in this run, so left out of the "
+                  "prediction): " + ", ".join(f"`{m}`" for m in missing) + "."]
         n_merl = full["nielsen"]
         l1 = sum(t["median"] for t in tim if t["part"] == "nielsen"
                  and t["batch"].endswith("-l1")) * n_merl / 2.0 / 60.0
