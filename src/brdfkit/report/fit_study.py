@@ -267,6 +267,7 @@ def _alpha_figure(study, path):
 
 def _fig1_figure(study, path, theta_i=(30.0, 60.0)):
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import NullFormatter
 
     import brdfkit
 
@@ -300,6 +301,7 @@ def _fig1_figure(study, path, theta_i=(30.0, 60.0)):
                 ax.set_xlabel("θ_o in the incidence plane (°; > 0: mirror side)", fontsize=8)
             if j == 0:
                 ax.set_ylabel("f · cos θ_i (channel mean)", fontsize=8)
+            ax.yaxis.set_minor_formatter(NullFormatter())  # short log ranges: no clutter
             ax.tick_params(labelsize=7)
     axes[0, 0].legend(fontsize=7, frameon=False, loc="lower left")
     fig.suptitle("α-mix fits (Fresnel, η free): L1 vs L2; grey line: mirror direction",
