@@ -152,3 +152,36 @@ def test_cli_batch_of_real_fits_resumes(tmp_path):
     assert r.exit_code == 0 and "0 fitted now, 2 already there" in r.output, r.output
     r = CliRunner().invoke(main, ["fit", "lambert", "--to", "merl:all"])
     assert r.exit_code == 2 and "--out" in r.output
+
+
+def test_parquet_round_trip_resume_and_interrupt(tmp_path):
+    """--out FILE.parquet: the same resumability as CSV, with typed columns read back."""
+    pq = pytest.importorskip("pyarrow.parquet")
+    out = tmp_path / "fits.parquet"
+
+    def stop_after_two(done, total, label):
+        if done == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(BatchInterrupted, match="2 of 7 rows"):
+        run_batch(JOBS + [Job("phong", "merl:boom")], out=out, run_job=job_fn,
+                  progress=stop_after_two)
+    assert len(_values(out)) == 2  # the rows finished before Ctrl-C are on disk, whole
+    rep = run_batch(JOBS + [Job("phong", "merl:boom")], out=out, run_job=job_fn)
+    assert (rep.total, rep.skipped, rep.done, rep.failed) == (7, 2, 5, 1)
+    rows = _values(out)
+    for j in JOBS:  # typed round trip: ints come back as ints, not strings
+        assert rows[(j.model, j.target)]["value"] == closed_form(j)
+        assert rows[(j.model, j.target)]["status"] == STATUS_OK
+    boom = rows[("phong", "merl:boom")]
+    assert boom["status"] == STATUS_ERROR and boom["value"] is None
+    table = pq.read_table(out)  # an ordinary Parquet file for any reader
+    assert table.column_names[:5] == ["model", "target", "loss", "procedure", "status"]
+    assert str(table.schema.field("value").type) == "int64"
+    # resume: every ok row is skipped, only the error row is retried
+    rep = run_batch(JOBS + [Job("phong", "merl:boom")], out=out, run_job=job_fn)
+    assert (rep.skipped, rep.done) == (6, 1) and len(_values(out)) == 7
+    bad = tmp_path / "junk.parquet"
+    bad.write_text("model,target\n")
+    with pytest.raises(BrdfkitError, match="not a Parquet file"):
+        run_batch(JOBS, out=bad, run_job=job_fn)

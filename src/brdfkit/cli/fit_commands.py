@@ -47,9 +47,10 @@ __all__ = ["fit_cmd"]
 @click.option("--plot", "plot", default=None, metavar="FILE",
               help="Write in-plane slices and albedo curves, measured vs fitted (.png/.svg; "
                    "one fit).")
-@click.option("--out", "out", default=None, metavar="FILE.csv",
-              help="Batch: every (MODEL, SPEC) fit as a row of FILE.csv, written atomically as "
-                   "each finishes; re-running resumes (finished rows are skipped).")
+@click.option("--out", "out", default=None, metavar="FILE.csv|FILE.parquet",
+              help="Batch: every (MODEL, SPEC) fit as a row of FILE (.csv, or .parquet with "
+                   "pyarrow), written atomically as each finishes; re-running resumes "
+                   "(finished rows are skipped).")
 @click.option("--workers", type=click.IntRange(1, 256), default=1, show_default=True,
               help="Batch: local worker processes.")
 @click.option("--scheduler", default=None, metavar="ADDRESS",

@@ -3,8 +3,9 @@ Batches of fits: resumable, written row by row, local processes or a Dask cluste
 =================================================================================
 
 :func:`run_batch` runs many independent jobs (a fit of one model to one
-material, say) and writes each finished row to a CSV file **as it completes**,
-atomically (the whole file is rewritten to a temporary file and renamed, so a
+material, say) and writes each finished row to a CSV or Parquet file (by the
+suffix: ``.csv``, ``.parquet``; Parquet needs pyarrow, the ``batch`` extra)
+**as it completes**, atomically (the whole file is rewritten to a temporary file and renamed, so a
 reader or a crash never sees half a row). Hence:
 
 - **Resume.** Re-running with the same output skips every job whose key is
@@ -56,6 +57,7 @@ from brdfkit._io import check_output_path, write_atomic
 from brdfkit.errors import BrdfkitError
 
 __all__ = ["Job", "run_batch", "BatchReport", "BatchInterrupted", "read_rows", "write_rows",
+           "SUFFIXES",
            "fit_row", "expand_targets", "KEY_COLUMNS", "STATUS_OK", "STATUS_ERROR",
            "STATUS_NOT_CONVERGED"]
 
@@ -112,31 +114,96 @@ def _key_of(row: dict) -> tuple:
     return tuple(str(row.get(c, "")) for c in KEY_COLUMNS)
 
 
+#: Suffixes of batch output files: CSV (always) and Parquet (with pyarrow).
+SUFFIXES = (".csv", ".parquet")
+
+
+def _is_parquet(path) -> bool:
+    return os.fspath(path).lower().endswith(".parquet")
+
+
+def _pyarrow(path):
+    try:
+        import pyarrow
+        import pyarrow.parquet
+    except ImportError:
+        raise BrdfkitError(f"--out {os.fspath(path)!r}: Parquet output needs pyarrow: pip "
+                           "install 'brdfkit[batch]' (or pip install pyarrow), or write "
+                           ".csv") from None
+    return pyarrow, pyarrow.parquet
+
+
+def _check_columns(p, names) -> None:
+    missing = [c for c in (*KEY_COLUMNS, "status") if c not in (names or ())]
+    if missing:
+        raise BrdfkitError(f"{p}: not a brdfkit batch file: expected columns "
+                           f"{', '.join((*KEY_COLUMNS, 'status'))}; missing "
+                           f"{', '.join(missing)} (choose another --out to start afresh)")
+
+
 def read_rows(path) -> list[dict]:
-    """Rows of a batch output file (CSV), as dicts of strings; [] if it does not exist.
+    """Rows of a batch output file, [] if it does not exist: from CSV as dicts of strings,
+    from Parquet with the stored types (None where a row has no value).
 
     Raises :class:`~brdfkit.errors.BrdfkitError` naming the file when it exists
-    but is not a batch file (no key columns)."""
+    but is not a batch file (no key columns, or not readable as Parquet)."""
     p = os.fspath(path)
     if not os.path.exists(p):
         return []
+    if _is_parquet(p):
+        _, pq = _pyarrow(p)
+        try:
+            table = pq.read_table(p)
+        except (OSError, ValueError) as exc:  # pyarrow's ArrowInvalid is a ValueError
+            raise BrdfkitError(f"{p}: not a Parquet file ({exc}); choose another --out to "
+                               "start afresh") from None
+        _check_columns(p, table.column_names)
+        return table.to_pylist()
     with open(p, newline="", encoding="utf-8") as fh:
         reader = csv.DictReader(fh)
-        missing = [c for c in (*KEY_COLUMNS, "status") if c not in (reader.fieldnames or ())]
-        if missing:
-            raise BrdfkitError(f"{p}: not a brdfkit batch file: expected columns "
-                               f"{', '.join((*KEY_COLUMNS, 'status'))}; missing "
-                               f"{', '.join(missing)} (choose another --out to start afresh)")
+        _check_columns(p, reader.fieldnames)
         return list(reader)
 
 
+def _column_type(pa, values):
+    """One Arrow type for a column: bool, int64 or float64 (ints and floats mixed) when
+    every value present is of that kind, else string (values written with str())."""
+    present = [v for v in values if v is not None]
+    if present and all(isinstance(v, bool) for v in present):
+        return pa.bool_()
+    if present and all(isinstance(v, int) and not isinstance(v, bool) for v in present):
+        return pa.int64()
+    if present and all(isinstance(v, int | float) and not isinstance(v, bool)
+                       for v in present):
+        return pa.float64()
+    return pa.string()
+
+
+def _write_parquet(path, rows, columns) -> str:
+    pa, pq = _pyarrow(path)
+    arrays = []
+    for c in columns:
+        vals = [r.get(c) for r in rows]
+        kind = _column_type(pa, vals)
+        if kind == pa.string():
+            vals = [None if v is None else str(v) for v in vals]
+        elif kind == pa.float64():
+            vals = [None if v is None else float(v) for v in vals]
+        arrays.append(pa.array(vals, type=kind))
+    table = pa.Table.from_arrays(arrays, names=list(columns))
+    return write_atomic(path, lambda fh: pq.write_table(table, fh), option="--out")
+
+
 def write_rows(path, rows: Iterable[dict]) -> str:
-    """Write *rows* as CSV atomically: key columns and status first, then the others in
-    order of first appearance."""
+    """Write *rows* atomically as CSV or, for a ``.parquet`` path, Parquet (one typed
+    column per field: bool, int64, float64 or string): key columns and status first, then
+    the others in order of first appearance."""
     rows = list(rows)
     columns = [*KEY_COLUMNS, "status"]
     for r in rows:
         columns.extend(c for c in r if c not in columns)
+    if _is_parquet(path):
+        return _write_parquet(path, rows, columns)
 
     def write(fh):
         text = io.StringIO()
@@ -182,7 +249,8 @@ def run_batch(jobs: Iterable[Job], *, out, run_job: Callable[[Job], dict], worke
     jobs : iterable of Job
         Duplicates (same key) run once.
     out : path
-        CSV output; existing ok rows are kept and their jobs skipped.
+        CSV or Parquet output (by suffix); existing ok rows are kept and their jobs
+        skipped.
     run_job : callable
         ``run_job(job) -> dict`` (module level, importable by the workers).
     workers : int, keyword-only
@@ -205,7 +273,9 @@ def run_batch(jobs: Iterable[Job], *, out, run_job: Callable[[Job], dict], worke
     BrdfkitError
         Bad *out*, *workers* or *retries*; an unreachable scheduler.
     """
-    path = check_output_path(out, option="--out", suffixes=(".csv",))
+    path = check_output_path(out, option="--out", suffixes=SUFFIXES)
+    if _is_parquet(path):
+        _pyarrow(path)  # fail before any fit when pyarrow is missing
     workers = _check_workers(workers)
     if not (isinstance(retries, int) and 0 <= retries <= 10):
         raise BrdfkitError(f"retries must be an integer from 0 to 10; got {retries!r}")
@@ -326,7 +396,9 @@ def fit_row(job: Job) -> dict:
     result into one row: status (ok / not-converged), the loss value, the parameters (JSON,
     ready for ``-p``), every metric (``metric_<name>``), the worst albedo relative error,
     the evaluations and the seconds. ``job.options`` may hold ``pump``, ``times``,
-    ``seed`` and ``theta_max_deg``."""
+    ``seed``, ``theta_max_deg``, ``params`` (a JSON object of starting values, e.g.
+    ``{"eta": 1.5}`` to fit an optional index η that is None by default) and ``fixed``
+    (a JSON list of parameter names held at those values, e.g. ``["alpha"]``)."""
     import json
     import math
 
@@ -338,15 +410,19 @@ def fit_row(job: Job) -> dict:
 
     opts = dict(job.options)
     m = build_spec(job.model)
+    if opts.get("params"):
+        m = m.with_params(**json.loads(opts["params"]))  # validated by the model
+    fixed = {k: m.values[k] for k in json.loads(opts.get("fixed") or "[]")}
     if opts.get("pump"):
         m = pump(m, g=opts["pump"], times=int(opts.get("times", 1)))
     target = build_spec(job.target)
     theta_max = opts.get("theta_max_deg")
     t0 = time.perf_counter()
     r = fit(m, target, loss=job.loss, procedure=job.procedure, seed=int(opts.get("seed", 0)),
+            fixed=fixed or None,
             theta_max=None if theta_max is None else math.radians(float(theta_max)))
     d = r.to_dict()
-    row = {"status": STATUS_OK if r.success else STATUS_NOT_CONVERGED,
+    row = {"status": STATUS_OK if r.success else STATUS_NOT_CONVERGED, "fit_status": r.status,
            "value": r.value, "params": json.dumps(d["params"], sort_keys=True)}
     row.update({f"metric_{k}": v for k, v in sorted(r.metrics.items())})
     rel = np.asarray(r.albedo_rel_error, dtype=np.float64)
