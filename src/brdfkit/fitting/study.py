@@ -96,6 +96,13 @@ SLICE_THETA_DEG = 30.0
 BASE_FRACTION = 0.1
 
 
+#: The Neumann part's pumped models: (batch name stem, g of brdfkit.pumping.pump).
+NEUMANN_PUMPS = (("pumped-phong", "max"), ("pumped-controlled-phong", "controlled"))
+#: Every Neumann model: (batch name stem, label in the report).
+NEUMANN_MODELS = (("phong", "Phong"), ("pumped-phong", "pumped Phong (g₁ = max)"),
+                  ("pumped-controlled-phong", "pumped Phong (g₂ = controlled)"))
+
+
 def is_metal(spec: str) -> bool:
     """True for a MERL material named as a metal (:data:`METAL_WORDS`, no "paint")."""
     name = str(spec).rsplit(":", 1)[-1]
@@ -107,7 +114,8 @@ class StudyBatch:
     """One batch of the study: *model* fitted to every target with *loss*.
 
     ``params`` are starting values (``fit_row``'s ``params`` option), ``fixed`` the
-    names held at them, ``pump`` pumps the model once with g = max."""
+    names held at them, ``pump`` pumps the model once with that g (``"max"``: g₁,
+    ``"controlled"``: g₂; :func:`brdfkit.pumping.pump`)."""
 
     part: str
     name: str
@@ -118,7 +126,7 @@ class StudyBatch:
     targets: tuple
     params: dict = field(default_factory=dict)
     fixed: tuple = ()
-    pump: bool = False
+    pump: str | None = None
 
     def path(self, directory) -> str:
         return os.path.join(os.fspath(directory), self.part, f"{self.name}.csv")
@@ -133,7 +141,7 @@ class StudyBatch:
         if self.fixed:
             opts["fixed"] = json.dumps(list(self.fixed))
         if self.pump:
-            opts.update(pump="max", times=1)
+            opts.update(pump=self.pump, times=1)
         return tuple(sorted(opts.items()))
 
     def jobs(self) -> list[Job]:
@@ -165,9 +173,14 @@ def study_batches(materials, *, parts=PARTS, ngan_names=None) -> list[StudyBatch
         for loss in ("perceptual", "l2"):  # the plain fits first: the pumped ones are slow
             out.append(StudyBatch("neumann", f"phong-{loss}", "modified Phong",
                                   "modified-phong", loss, "auto", metals))
-        for loss in ("perceptual", "l2"):
-            out.append(StudyBatch("neumann", f"pumped-phong-{loss}", "pumped modified Phong",
-                                  "modified-phong", loss, "auto", metals, pump=True))
+        # g₁ = max normalises the albedo at normal incidence to 1 (f/g₁ does not see a
+        # common scale of ρ_d, ρ_s: fit holds it), so it cannot match a dark metal's level;
+        # g₂ = controlled keeps the scale: both are fitted
+        for name, g in NEUMANN_PUMPS:
+            for loss in ("perceptual", "l2"):
+                out.append(StudyBatch("neumann", f"{name}-{loss}", f"pumped modified Phong "
+                                      f"(g = {g})", "modified-phong", loss, "auto", metals,
+                                      pump=g))
     if "anchors" in parts:
         names = set(ngan_names) if ngan_names is not None else None
         targets = tuple(m for m in materials
@@ -220,7 +233,7 @@ def derived_jobs(batch: StudyBatch, directory) -> list[Job]:
     for r in read_rows(batch.path(directory)):
         if r.get("status") not in (STATUS_OK, STATUS_NOT_CONVERGED):
             continue
-        opts = {"params": r["params"], **({"pump": "max"} if batch.pump else {})}
+        opts = {"params": r["params"], **({"pump": batch.pump} if batch.pump else {})}
         jobs.append(Job(r["model"], r["target"], loss=r["loss"],
                         procedure=f"{r['procedure']}@{params_hash(r['params'])}",
                         options=tuple(sorted(opts.items()))))

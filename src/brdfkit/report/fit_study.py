@@ -27,6 +27,7 @@ from brdfkit.fitting.procedure import STATUS_MESSAGES
 from brdfkit.fitting.study import (
     FIG1,
     METAL_WORDS,
+    NEUMANN_MODELS,
     NGAN_CONVENTIONS,
     in_plane_slice,
     is_metal,
@@ -35,6 +36,8 @@ from brdfkit.fitting.study import (
 )
 
 __all__ = ["write_report", "claims", "nielsen_table", "FULL_MATERIALS"]
+
+_LABEL = dict(NEUMANN_MODELS)
 
 #: Materials of the full study (every MERL material).
 FULL_MATERIALS = 100
@@ -185,7 +188,7 @@ def _fit_status(row) -> int:
 def _neumann_claims(study) -> list[dict]:
     out = []
     pairs = []
-    for plain in ("phong", "pumped-phong"):
+    for plain, _ in NEUMANN_MODELS:
         per = _by_target(study.get(("neumann", f"{plain}-perceptual"), []))
         l2 = _by_target(study.get(("neumann", f"{plain}-l2"), []))
         for t in sorted(set(per) & set(l2)):
@@ -202,24 +205,28 @@ def _neumann_claims(study) -> list[dict]:
                     "smaller maximal relative errors than least squares", "test": "max(e_point,"
                     " e_albedo) of the perceptual fit below that of the L2 fit", "verdict":
                     verdict, "evidence": f"{len(won)} of {len(pairs)} (model, metal) pairs: "
-                    + ", ".join(f"{_name(t)} ({'pumped ' if m != 'phong' else ''}Phong) "
+                    + ", ".join(f"{_name(t)} ({_LABEL[m]}) "
                                 f"{a:.3g} vs {b:.3g}" for m, t, a, b in pairs) + "."})
-    rows = []
-    for loss in ("perceptual", "l2"):
-        plain = _by_target(study.get(("neumann", f"phong-{loss}"), []))
-        pumped = _by_target(study.get(("neumann", f"pumped-phong-{loss}"), []))
-        for t in sorted(set(plain) & set(pumped)):
-            rows.append((loss, t, _f(pumped[t][f"metric_{loss}"]),
-                         _f(plain[t][f"metric_{loss}"])))
-    if rows:
+    for stem, label in NEUMANN_MODELS[1:]:
+        rows = []
+        for loss in ("perceptual", "l2"):
+            plain = _by_target(study.get(("neumann", f"phong-{loss}"), []))
+            pumped = _by_target(study.get(("neumann", f"{stem}-{loss}"), []))
+            for t in sorted(set(plain) & set(pumped)):
+                rows.append((loss, t, _f(pumped[t][f"metric_{loss}"]),
+                             _f(plain[t][f"metric_{loss}"])))
+        if not rows:
+            continue
         won = [r for r in rows if r[2] < r[3]]
         verdict = ("supported" if len(won) == len(rows) else
                    "partly supported" if won else "not supported")
+        gain = np.median([1.0 - a / b for _, _, a, b in rows if b > 0]) if rows else math.nan
         out.append({"paper": "Neumann 1999 §3, §6", "claim": "pumping up the albedo makes "
                     "Phong fit metals better (a better energy mirror at grazing angles)",
-                    "test": "the one-times pumped modified Phong fit has a smaller loss than "
+                    "test": f"the one-times {label} fit has a smaller loss than "
                     "the plain fit under the same loss", "verdict": verdict, "evidence":
-                    f"{len(won)} of {len(rows)} (loss, metal) pairs: "
+                    f"{len(won)} of {len(rows)} (loss, metal) pairs; median relative gain "
+                    f"{100 * gain:.1f} %: "
                     + ", ".join(f"{_name(t)} {loss} {a:.4g} vs {b:.4g}"
                                 for loss, t, a, b in rows) + "."})
     return out
@@ -313,10 +320,10 @@ def _neumann_figure(study, path):
     import matplotlib.pyplot as plt
 
     series = []
-    for model in ("phong", "pumped-phong"):
+    for model, label in NEUMANN_MODELS:
         for loss in ("perceptual", "l2"):
             rows = _by_target(study.get(("neumann", f"{model}-{loss}"), []))
-            series.append((f"{'pumped ' if model != 'phong' else ''}Phong, {loss}", rows))
+            series.append((f"{label}, {loss}", rows))
     targets = sorted(set().union(*[set(r) for _, r in series]))
     if not targets:
         return None
@@ -502,14 +509,18 @@ def write_report(directory, *, out="docs/fitting-study.md", figures="docs/figure
                                                                      METAL_WORDS)
               + " and not `paint`. e_point = max |ln((f̂ cos θ_i + τ)/(f cos θ_i + τ))| over "
               "the fit's samples (τ: the perceptual loss's floor), e_albedo = max |ln(â/a)| "
-              "over θ_i = 0…80° (true maxima, not the smooth means optimised).", ""]
+              "over θ_i = 0…80° (true maxima, not the smooth means optimised).", "",
+              "Pumped once with g₁ = max(a(L), a(V)) (eq. 20) the model's albedo at normal "
+              "incidence is 1 whatever ρ_d, ρ_s are (f/g₁ does not see their common scale; "
+              "the fit holds it), so it cannot match a metal's level; with the controlled "
+              "g₂ = max(a(L), a(V), N·L, N·V) (eq. 21) the scale is kept. Both are fitted.", ""]
         rows = []
-        for model in ("phong", "pumped-phong"):
+        for model, label in NEUMANN_MODELS:
             for loss in ("perceptual", "l2"):
                 for t, r in sorted(_by_target(study.get(("neumann", f"{model}-{loss}"),
                                                         [])).items()):
                     d = r.get("derived") or {}
-                    rows.append([_name(t), ("pumped " if model != "phong" else "") + "Phong",
+                    rows.append([_name(t), label,
                                  loss, _num(_f(d.get("e_point")), ".3f"),
                                  _num(_f(d.get("e_albedo")), ".3f"),
                                  _num(_f(r.get("metric_perceptual")), ".4g"),
