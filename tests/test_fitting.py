@@ -141,3 +141,20 @@ def test_fit_rejects_bad_arguments():
         fit(m, "merl:nickel")
     res = run("fit", "modified-phong", "--to", "merl:nickel", "--loss", "l3")
     assert res.exit_code == 2
+
+
+def test_fit_command_start_frees_an_optional_parameter(tmp_path):
+    # nielsen with a Fresnel index eta = 1.8 (its default is None: no Fresnel) written as a
+    # MERL .binary; --start eta=1.5 must fit eta (reference: the value the data were made
+    # with), -p holds s and alpha at their true values to keep the fit small.
+    src = brdfkit.model("nielsen", rho_d=0.2, k_s=0.5, s=40.0, alpha=0.5, eta=1.8)
+    path = write_binary(tmp_path / "fresnel.binary", table_from_function(src.eval))
+    res = run("fit", "nielsen", "--to", str(path), "--start", "eta=1.5", "-p", "s=40",
+              "-p", "alpha=0.5", "--json")
+    assert res.exit_code == 0, res.output
+    d = json.loads(res.output)
+    np.testing.assert_allclose(d["params"]["eta"], 1.8, rtol=1e-2)
+    assert d["params"]["s"] == 40.0  # held
+    # the same name held and started: one line, exit 2
+    res = run("fit", "nielsen", "--to", str(path), "--start", "eta=1.5", "-p", "eta=2")
+    assert res.exit_code == 2 and "both -p (held) and --start (fitted)" in res.output

@@ -12,6 +12,7 @@ passed back as ``-p``. SPEC is resolved by :func:`brdfkit.data.material`
 
 from __future__ import annotations
 
+import json
 import math
 
 import click
@@ -27,6 +28,10 @@ __all__ = ["fit_cmd"]
 @click.argument("models", nargs=-1, required=True, metavar="MODEL...")
 @click.option("-p", "--param", "param", multiple=True, metavar="NAME=VALUE",
               help="Hold a parameter of MODEL fixed (repeatable; one MODEL only). " + PARAM_HELP)
+@click.option("--start", "start", multiple=True, metavar="NAME=VALUE",
+              help="Start a parameter at VALUE and fit it (-p holds it instead); frees an "
+                   "optional one that is off by default, e.g. --start eta=1.5 fits a "
+                   "Fresnel index.")
 @click.option("--pump", type=click.Choice(["max", "controlled"]), default=None,
               help="Fit the pumped model (its base parameters are fitted).")
 @click.option("--times", type=int, default=None, metavar="K", help="Pump K times (with --pump).")
@@ -55,11 +60,13 @@ __all__ = ["fit_cmd"]
               help="Batch: local worker processes.")
 @click.option("--scheduler", default=None, metavar="ADDRESS",
               help="Batch: run on this Dask distributed scheduler (tcp://host:8786) instead.")
-def fit_cmd(models, param, pump, times, to, loss, procedure, seed, starts, theta_max, as_json,
-            plot, out, workers, scheduler):
-    """Fit MODEL's parameters to a measured material (-p NAME=VALUE holds a parameter).
+def fit_cmd(models, param, start, pump, times, to, loss, procedure, seed, starts, theta_max,
+            as_json, plot, out, workers, scheduler):
+    """Fit MODEL's parameters to a measured material (-p NAME=VALUE holds a parameter,
+    --start NAME=VALUE starts it there and fits it).
 
     Example: brdfkit fit nielsen --to merl:nickel --json
+    (with a Fresnel factor, η fitted: brdfkit fit nielsen --to merl:nickel --start eta=1.5)
 
     Batch: several MODELs and/or materials, with --out FILE.csv, e.g.
     brdfkit fit modified-phong nielsen --to merl:all --out fits.csv --workers 2
@@ -70,7 +77,7 @@ def fit_cmd(models, param, pump, times, to, loss, procedure, seed, starts, theta
 
     targets = expand_targets(to)
     if out is not None or len(models) > 1 or len(targets) > 1:
-        _batch(models, targets, param=param, pump=pump, times=times, loss=loss,
+        _batch(models, targets, param=param, start=start, pump=pump, times=times, loss=loss,
                procedure=procedure, seed=seed, theta_max=theta_max, as_json=as_json,
                plot=plot, out=out, workers=workers, scheduler=scheduler)
         return
@@ -84,8 +91,12 @@ def fit_cmd(models, param, pump, times, to, loss, procedure, seed, starts, theta
 
     if plot:
         check_output_path(plot, option="--plot")  # fail before the fit, not after
-    m = build_model(model, param, pump=pump, times=times)
     given = parse_param_items(model, param)
+    both = sorted(set(given) & set(parse_param_items(model, start)))
+    if both:
+        raise BrdfkitError(f"{', '.join(both)}: given with both -p (held) and --start (fitted); "
+                           "use one")
+    m = build_model(model, (*start, *param), pump=pump, times=times)
     if "beta" in given:
         if m.width_param is None:
             raise BrdfkitError(f"{model}: has no lobe width, so 'beta' is not a parameter")
@@ -116,7 +127,7 @@ def fit_cmd(models, param, pump, times, to, loss, procedure, seed, starts, theta
     click.echo(f"# as a model: brdfkit eval {d['model']} {fixed_args}")
 
 
-def _batch(models, targets, *, param, pump, times, loss, procedure, seed, theta_max, as_json,
+def _batch(models, targets, *, param, start, pump, times, loss, procedure, seed, theta_max, as_json,
            plot, out, workers, scheduler) -> None:
     """``brdfkit fit MODEL... --to SPEC... --out FILE.csv``: one row per fit."""
     from brdfkit._specs import canonical_name
@@ -134,7 +145,14 @@ def _batch(models, targets, *, param, pump, times, loss, procedure, seed, theta_
         raise BrdfkitError(f"--times {times} needs --pump max or --pump controlled")
     for m in models:
         canonical_name(m)  # an unknown model fails now, not in every row
+    starts = {}
+    for m in models if start else ():  # starting values; every model must take them
+        starts = parse_param_items(m, start)
+        if "beta" in starts:
+            raise BrdfkitError("--start beta=...: a batch takes the models' own parameter "
+                               "names (the width parameter, not beta)")
     options = tuple(sorted({"seed": seed, **({"pump": pump, "times": times or 1} if pump else {}),
+                            **({"params": json.dumps(starts, sort_keys=True)} if starts else {}),
                             **({"theta_max_deg": theta_max} if theta_max else {})}.items()))
     jobs = [Job(m, t, loss=loss, procedure=procedure, options=options)
             for m in models for t in targets]
