@@ -31,7 +31,7 @@ MAX_LINES = 850
 #: hooks of the model protocol that must be read as declared attributes, never probed
 HOOKS = {"isotropic", "specular_albedo", "albedo_kinks", "albedo_kinks_nv", "albedo_kink_mus",
          "has_delta", "has_sampler", "lobes", "sharpest_lobe", "kernel", "packed", "n_channels",
-         "reciprocal", "sample", "pdf", "to_dict", "formulas"}
+         "reciprocal", "sample", "pdf", "to_dict", "formulas", "fit_gauge"}
 
 
 def _modules():

@@ -56,3 +56,21 @@ def test_eta_is_recovered_and_an_undetermined_eta_is_reported_at_its_bound():
     # reproducible with the same seed
     again = fit(brdfkit.model("nielsen", eta=1.5), brdfkit.model("nielsen", **truth))
     assert again.params == r.params
+
+
+def test_lafortune_gauge_held_and_the_lobe_recovered():
+    # Lafortune data with C_xy = -1.6, C_z = 2, n = 12, rho_s = 0.1 (a lobe tilted towards
+    # grazing). (C_xy, C_z) -> t (C_xy, C_z), rho_s -> rho_s / t^n leaves f unchanged
+    # (identity of the formula), so from the default C_z = 1 (held: fit_gauge) the exact
+    # answer is C_xy = -0.8, rho_s = 0.1 * 2^12 -- the same BRDF, which the fit must reach.
+    from brdfkit.data import MeasuredBRDF, table_from_function
+
+    src = brdfkit.model("lafortune", rho_d=0.1, rho_s=0.1, C_xy=-1.6, C_z=2.0, n=12.0)
+    target = MeasuredBRDF(table_from_function(src.eval))
+    r = fit(brdfkit.model("lafortune"), target, loss="l2")
+    assert r.convergence["gauge_held"] == {"C_z[0]": 1.0}
+    assert r.status == 0, r.message
+    assert r.params["C_z"] == [1.0]
+    assert r.params["C_xy"][0] == pytest.approx(-0.8, rel=1e-3)
+    assert r.params["n"][0] == pytest.approx(12.0, rel=1e-3)
+    assert r.params["rho_s"] == pytest.approx([0.1 * 2.0 ** 12] * 3, rel=1e-2)

@@ -401,6 +401,12 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
     record = {"procedure": procedure, "loss": loss, "seed": seed,
               "n_samples": len(prob.samples), "n_samples_search": len(sp.samples),
               "stages": [], "starts": []}
+    # a gauge freedom of the model (BRDF.fit_gauge) is held at its given value, unless
+    # that value is 0 (there the other coordinates no longer absorb it)
+    gauge = [c for c in coords if c.label in model.fit_gauge and _val(values, c) != 0.0]
+    if gauge:
+        coords = [c for c in coords if c not in gauge]
+        record["gauge_held"] = {c.label: _val(values, c) for c in gauge}
     # a one-times pumped model is evaluated through its surrogate (tables per shape
     # parameter, linear parameters combined: brdfkit.pumping.surrogate) until _result,
     # which evaluates the exact model

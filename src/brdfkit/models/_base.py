@@ -464,6 +464,11 @@ class BRDF:
     #: Whether the model has a specular delta term that is not in :attr:`kernel` (its
     #: energy is :meth:`specular_albedo`).
     has_delta: ClassVar[bool] = False
+    #: Parameter coordinates (labels as ``"C_z[0]"``) that a fit holds at their given value:
+    #: a gauge freedom, the model unchanged when they move with others (e.g. Lafortune's
+    #: first lobe: (C_xy, C_z) → t·(C_xy, C_z) with ρ_s → ρ_s / tⁿ). Fitted, they make the
+    #: loss exactly flat along a curve and the optimiser crawl along it to its budget.
+    fit_gauge: ClassVar[tuple[str, ...]] = ()
     #: Compiled loop specialised to ``kernel`` (:func:`checked_driver`), or None for the
     #: generic :func:`eval_pairs_checked` (a composite kernel, e.g. pumped, sets one).
     _driver: Callable | None = None

@@ -94,6 +94,8 @@ class Lafortune(CosineLobeBRDF):
     ``C_xy``, ``C_z`` and ``n`` may be sequences (one value per lobe, equal
     lengths; scalars broadcast). The lobe's peak is max(|C_xy|, |C_z|)ⁿ, which
     must stay finite (checked). Reciprocal (the form is symmetric in wi, wo).
+    A fit (:func:`brdfkit.fitting.fit`) holds the first lobe's C_z at its given
+    value (a gauge: its scale against ρ_s is not determined; ``fit_gauge``).
     Sampled as a mixture of cosine and, per lobe, the cosⁿ lobe about the unit
     axis along (C_xy ox, C_xy oy, C_z oz) — exact in shape, since the base is
     wi·(C_xy ox, C_xy oy, C_z oz) — weighted by its integral.
@@ -115,6 +117,10 @@ class Lafortune(CosineLobeBRDF):
     reciprocal = True
     width_param = "n"
     kernel = _lafortune
+    # (C_xy, C_z) → t·(C_xy, C_z), ρ_s → ρ_s / tⁿ leaves the first lobe and the others
+    # unchanged: a fit holds C_z of the first lobe (at its given value, default 1: the
+    # scale goes into ρ_s, the direction into C_xy / C_z)
+    fit_gauge = ("C_z[0]",)
     examples = (
         {"C_xy": [-1.0, -0.9], "C_z": [1.0, 0.7], "n": [20.0, 5.0]},
         {"rho_d": 0.0, "C_xy": -1.0, "C_z": 1.0, "n": 10000.0},
