@@ -149,6 +149,10 @@ EXACT_PROJECTION = ("l1", "l2", "ngan")
 IRLS_FINAL = 50
 #: Two stage-(ii) runs whose losses agree to this relative difference are one optimum.
 CONSENSUS = 1e-3
+#: Least evaluation budget of a polish (else 100 per coordinate; it stops at convergence):
+#: 200 was too few for Lafortune's (C_xy, n) on six MERL materials (light-red-paint: 406).
+POLISH_MIN_EVALS = 600
+_polish = lambda max_evals, free: max(max_evals, 100 * len(free), POLISH_MIN_EVALS)  # noqa: E731
 #: Stage (ii) searches on this coarser merging of MERL bins (θ_d, φ_d): every θ_h bin and
 #: the default's 10 θ_d cells kept (a Fresnel factor depends on θ_d; with 6 θ_d cells the
 #: search misjudged red-fabric2's η fit), 4 φ_d cells instead of 12: 2,676 samples instead
@@ -663,7 +667,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         # a tenth of stage (ii)'s steps: stage (iii) starts near a stationary point
         steps = 0.1 * np.array([c.step(_val(values, c)) for c in free3])
         end, val, _, limit = search(prob, free3, values, projected3,
-                                    max(max_evals, 100 * len(free3)), steps, FRTOL_POLISH)
+                                    _polish(max_evals, free3), steps, FRTOL_POLISH)
         if projected3:  # the final linear solve to convergence (IRLS_FINAL steps for l1)
             end = solve_at(prob, end, iterations=IRLS_FINAL) or end
             val = prob.loss_at(end)
@@ -692,7 +696,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
                 start = from_vector([Z_MAX if side == "upper" else -Z_MAX], [c], start)
             steps = 0.1 * np.array([c.step(_val(start, c)) for c in rest])
             end, val, _, limit = search(prob, rest, start, projected3,
-                                        max(max_evals, 100 * len(rest)), steps, FRTOL_POLISH)
+                                        _polish(max_evals, rest), steps, FRTOL_POLISH)
             if projected3:
                 end = solve_at(prob, end, iterations=IRLS_FINAL) or end
                 val = prob.loss_at(end)
