@@ -81,7 +81,10 @@ def loss_value(name: str, m, y, w, *, ngan_mask=None, albedo_m=None, albedo_t=No
     if name == "ngan":
         k = ngan_mask
         d = m[k] - y[k]
-        return float(np.sqrt(np.sum(w[k, None] * d * d) / (np.sum(w[k]) * y.shape[1])))
+        # a search step to an extreme lobe (values ~1e160) squares to inf: the loss is then
+        # inf, which the optimiser rejects; no warning for it
+        with np.errstate(over="ignore"):
+            return float(np.sqrt(np.sum(w[k, None] * d * d) / (np.sum(w[k]) * y.shape[1])))
     if name == "log":
         # log1p of a negative m (a model below 0 is not a BRDF): clamped at 0 so the loss
         # stays finite; no registered model goes below 0
