@@ -632,9 +632,9 @@ def write_report(directory, *, out="docs/fitting-study.md", figures="docs/figure
                   + ",".join(mats) + f" --workers 2 {ngan_arg}",
                   f"PYTHONPATH=src python scripts/fit_study.py report --dir {here}", ""]
         L += ["# the full study (every MERL material)",
-              f"PYTHONPATH=src python scripts/fit_study.py run --dir study --materials merl:all "
-              f"--workers 2 {ngan_arg}",
-              "PYTHONPATH=src python scripts/fit_study.py report --dir study"]
+              f"PYTHONPATH=src python scripts/fit_study.py run --dir {here} --materials "
+              f"merl:all --workers 2 {ngan_arg}",
+              f"PYTHONPATH=src python scripts/fit_study.py report --dir {here}"]
     L += ["```", ""]
     text = "\n".join(L)
     write_atomic(out, lambda fh: fh.write(text.encode("utf-8")))
