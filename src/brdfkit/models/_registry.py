@@ -16,7 +16,15 @@ _ALIASES: dict[str, str] = {}
 
 
 def register(cls: type) -> type:
-    """Class decorator: add a model class to :data:`MODELS` under its name and aliases."""
+    """Class decorator: add a model class to :data:`MODELS` under its name and aliases.
+
+    A class-level ``kernel`` (a Numba dispatcher) is held as a static method: a dispatcher
+    is a descriptor, so read from an instance it would bind, giving a new bound method per
+    model, and every cache keyed on ``model.kernel`` (compiled drivers of pumped models,
+    swapped kernels) would miss for each new parameter value and compile again."""
+    kernel = cls.__dict__.get("kernel")
+    if kernel is not None and not isinstance(kernel, staticmethod):
+        cls.kernel = staticmethod(kernel)
     for key in (cls.name, *cls.aliases):
         if key in MODELS or key in _ALIASES:
             raise RuntimeError(f"model name {key!r} registered twice")

@@ -18,8 +18,6 @@ NumPy for models evaluated without a kernel.
 
 from __future__ import annotations
 
-import types
-
 import numba
 import numpy as np
 
@@ -29,15 +27,6 @@ from brdfkit.tables import _lookup
 __all__ = ["G_NUMPY", "chain_kernel", "stage_kernel"]
 
 _KERNELS: dict = {}
-
-
-def _function(kernel):
-    """The compiled function behind *kernel*: a registered model's ``kernel`` is a class
-    attribute holding a Numba dispatcher, which Python binds to the instance when read
-    from it (``model.kernel`` is a new bound method per model). Keyed on that, the cache
-    below missed for every new parameter value and compiled a new driver each time
-    (4-7 s per pumped model); Numba types the bound method as the dispatcher anyway."""
-    return kernel.__func__ if isinstance(kernel, types.MethodType) else kernel
 
 
 def chain_kernel(root_kernel, k: int, capped: bool):
@@ -52,7 +41,6 @@ def chain_kernel(root_kernel, k: int, capped: bool):
     stage caps g at 1, so q ≥ 1 exactly (the lookup's margin may dip below 1
     where q = 1; raising it back keeps q̃ ≤ q because q ≥ 1 there).
     """
-    root_kernel = _function(root_kernel)
     key = (root_kernel, "chain", k, capped)
     if key not in _KERNELS:
         @numba.njit(inline="always")  # inlined into its own driver (checked_driver)
@@ -78,7 +66,6 @@ def stage_kernel(base_kernel, controlled: bool, capped: bool, depth: int):
     g ≤ 1 (eq. 17) is applied after the lookup (whose margin may exceed 1
     where a = 1).
     """
-    base_kernel = _function(base_kernel)
     key = (base_kernel, "stage", controlled, capped, depth)
     if key not in _KERNELS:
         @numba.njit(inline="always")  # inlined into its own driver (checked_driver)

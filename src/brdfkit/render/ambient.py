@@ -40,7 +40,6 @@ References
 from __future__ import annotations
 
 import math
-import types
 import weakref
 from dataclasses import dataclass
 
@@ -68,14 +67,7 @@ _SWAPPED: dict = {}
 
 
 def _swapped_kernel(kernel):
-    """The compiled kernel with its two directions exchanged (cached per kernel).
-
-    Keyed on the compiled function, not on what ``model.kernel`` returns: a registered
-    model's kernel is a class attribute holding a Numba dispatcher, which Python binds to
-    the instance when read from it (a new bound method per model), so a key on that missed
-    for every new parameter value and compiled a new function each time (the same defect
-    as in :mod:`brdfkit.pumping.kernels`)."""
-    kernel = kernel.__func__ if isinstance(kernel, types.MethodType) else kernel
+    """The compiled kernel with its two directions exchanged (cached per kernel)."""
     if kernel not in _SWAPPED:
         @numba.njit
         def swapped(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
