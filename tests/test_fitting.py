@@ -158,3 +158,53 @@ def test_fit_command_start_frees_an_optional_parameter(tmp_path):
     # the same name held and started: one line, exit 2
     res = run("fit", "nielsen", "--to", str(path), "--start", "eta=1.5", "-p", "eta=2")
     assert res.exit_code == 2 and "both -p (held) and --start (fitted)" in res.output
+
+
+@pytest.mark.parametrize("adaptive", [False, True])
+def test_simplex_search_takes_scipys_steps(adaptive):
+    # Reference: scipy.optimize.minimize(method="Nelder-Mead", xatol=inf), which the
+    # procedure called before brdfkit.fitting._simplex replaced it (an independent
+    # implementation of the same algorithm): the same evaluations give the same result.
+    from scipy.optimize import minimize
+
+    from brdfkit.fitting._simplex import nelder_mead
+
+    def rosen(x):
+        return float(np.sum(100.0 * (x[1:] - x[:-1] ** 2) ** 2 + (1.0 - x[:-1]) ** 2))
+
+    x0 = np.array([-1.2, 1.0, 0.5])
+    simplex = np.vstack([x0] + [x0 + 0.3 * np.eye(3)[k] for k in range(3)])
+    for maxfev in (7, 150, 2000):  # cut inside the first simplex, mid-run, converged
+        ref = minimize(rosen, x0, method="Nelder-Mead",
+                       options={"initial_simplex": simplex, "maxfev": maxfev,
+                                "xatol": math.inf, "fatol": 1e-10, "adaptive": adaptive})
+        x, fx, nfev = nelder_mead(rosen, simplex, maxfev=maxfev, fatol=1e-10,
+                                  adaptive=adaptive)
+        assert nfev == ref.nfev
+        assert fx == ref.fun
+        np.testing.assert_array_equal(x, ref.x)
+
+
+@pytest.mark.parametrize("K", [1, 2, 3, 4])
+def test_solve_channels_matches_the_single_channel_solve_and_its_loss(K):
+    # Reference: solve_channel per channel (itself checked against lsq_linear and linprog
+    # above) and the loss summed in NumPy; K = 4 takes the general (not vectorised) path.
+    from brdfkit.fitting._linear import solve_channels
+
+    rng = np.random.default_rng(K)
+    N, C = 500, 3
+    B = rng.random((K, N, C))
+    R = np.einsum("knc,k->nc", B, rng.random(K)) + 0.05 * rng.standard_normal((N, C))
+    w = rng.random(N) + 0.1
+    lo, hi = np.zeros(K), np.full(K, 10.0)
+    for l1 in (False, True):
+        P, total = solve_channels(B, R, w, lo, hi, l1, 20, np.empty((0, 0)))
+        ref = np.stack([solve_channel(np.ascontiguousarray(B[:, :, c].T),
+                                      np.ascontiguousarray(R[:, c]), w, lo, hi, l1, 20,
+                                      np.empty(0)) for c in range(C)], axis=1)
+        np.testing.assert_allclose(P, ref, rtol=1e-12, atol=1e-14)
+        d = np.einsum("knc,kc->nc", B, P) - R
+        assert total == pytest.approx(float(np.sum(w[:, None] * (np.abs(d) if l1 else d * d))),
+                                      rel=1e-12)
+    B[0, 3, 1] = np.nan  # a non-finite basis value: the loss is inf, not NaN
+    assert solve_channels(B, R, w, lo, hi, True, 3, np.empty((0, 0)))[1] == math.inf

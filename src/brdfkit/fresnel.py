@@ -112,13 +112,22 @@ _fresnel_dielectric = numba.njit(cache=True, inline="always")(_fresnel_dielectri
 _fresnel_conductor = formula(_fresnel_conductor_py)  # Numba; Dr.Jit: _dual.drjit_version
 _fresnel_schlick = numba.njit(cache=True, inline="always")(_fresnel_schlick_py)
 
-_ufunc_dielectric = numba.vectorize(["float64(float64, float64)"], cache=True)(
-    _fresnel_dielectric_py
-)
-_ufunc_conductor = numba.vectorize(["float64(float64, float64, float64)"], cache=True)(
-    _fresnel_conductor_py
-)
-_ufunc_schlick = numba.vectorize(["float64(float64, float64)"], cache=True)(_fresnel_schlick_py)
+# The array versions, compiled (or loaded from Numba's cache) on first use: building a
+# ufunc's wrapper costs ~0.1-0.3 s even from the cache, which every `import brdfkit` paid
+# before (most commands never call these).
+_UFUNC_SPECS = {
+    "dielectric": ("float64(float64, float64)", _fresnel_dielectric_py),
+    "conductor": ("float64(float64, float64, float64)", _fresnel_conductor_py),
+    "schlick": ("float64(float64, float64)", _fresnel_schlick_py),
+}
+_ufuncs: dict = {}
+
+
+def _ufunc(name: str):
+    if name not in _ufuncs:
+        signature, py_func = _UFUNC_SPECS[name]
+        _ufuncs[name] = numba.vectorize([signature], cache=True)(py_func)
+    return _ufuncs[name]
 
 
 def _check_positive(name: str, value) -> np.ndarray:
@@ -147,7 +156,7 @@ def fresnel_dielectric(cos_theta, eta):
         g² = η² + c² − 1 (Lewis §3.2). F(c=1) = ((η−1)/(η+1))², F(c=0) = 1.
     """
     eta = _check_positive("eta", eta)
-    return _ufunc_dielectric(np.asarray(cos_theta, dtype=np.float64), eta)
+    return _ufunc("dielectric")(np.asarray(cos_theta, dtype=np.float64), eta)
 
 
 def fresnel_conductor(cos_theta, eta, k):
@@ -166,7 +175,7 @@ def fresnel_conductor(cos_theta, eta, k):
     k_arr = np.asarray(k, dtype=np.float64)
     if np.any(~(k_arr >= 0.0)):
         raise ValueError(f"k (extinction coefficient) must be >= 0; got {k!r}")
-    return _ufunc_conductor(np.asarray(cos_theta, dtype=np.float64), eta, k_arr)
+    return _ufunc("conductor")(np.asarray(cos_theta, dtype=np.float64), eta, k_arr)
 
 
 def fresnel_schlick(cos_theta, f0):
@@ -174,7 +183,7 @@ def fresnel_schlick(cos_theta, f0):
     f0_arr = np.asarray(f0, dtype=np.float64)
     if np.any(~((f0_arr >= 0.0) & (f0_arr <= 1.0))):
         raise ValueError(f"f0 must lie in [0, 1]; got {f0!r}")
-    return _ufunc_schlick(np.asarray(cos_theta, dtype=np.float64), f0_arr)
+    return _ufunc("schlick")(np.asarray(cos_theta, dtype=np.float64), f0_arr)
 
 
 def f0_from_eta(eta):

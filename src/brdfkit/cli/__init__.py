@@ -24,7 +24,8 @@ the command modules import :mod:`brdfkit.cli._common` and never this module.
 - :mod:`brdfkit.cli._progress` — progress on stderr.
 
 To add a command: write it with ``@click.command(...)`` in a module under
-``brdfkit/cli/`` and add one ``main.add_command(...)`` line below.
+``brdfkit/cli/`` and add one line to ``_COMMANDS`` below (commands are
+imported when looked up, so each command pays only for its own imports).
 
 Public objects
 --------------
@@ -37,17 +38,28 @@ import click
 
 import brdfkit
 from brdfkit.cli._group import BrdfkitGroup
-from brdfkit.cli.analysis import albedo_cmd, check_cmd, figure_cmd, table2_cmd
-from brdfkit.cli.data_commands import export_cmd, materials_cmd
-from brdfkit.cli.explore_commands import explore_cmd
-from brdfkit.cli.fit_commands import fit_cmd
-from brdfkit.cli.model_commands import eval_cmd, models_cmd
-from brdfkit.cli.render_commands import render_group, sphere_cmd
 
 __all__ = ["main"]
 
 
-@click.group("brdfkit", cls=BrdfkitGroup, context_settings={"help_option_names": ["-h", "--help"]})
+#: command name -> where it is defined; imported only when the command is looked up
+_COMMANDS = {
+    "models": "brdfkit.cli.model_commands:models_cmd",
+    "eval": "brdfkit.cli.model_commands:eval_cmd",
+    "albedo": "brdfkit.cli.analysis:albedo_cmd",
+    "check": "brdfkit.cli.analysis:check_cmd",
+    "table2": "brdfkit.cli.analysis:table2_cmd",
+    "figure": "brdfkit.cli.analysis:figure_cmd",
+    "materials": "brdfkit.cli.data_commands:materials_cmd",
+    "export": "brdfkit.cli.data_commands:export_cmd",
+    "explore": "brdfkit.cli.explore_commands:explore_cmd",
+    "render": "brdfkit.cli.render_commands:render_group",
+    "fit": "brdfkit.cli.fit_commands:fit_cmd",
+}
+
+
+@click.group("brdfkit", cls=BrdfkitGroup, lazy=_COMMANDS,
+             context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(brdfkit.__version__, prog_name="brdfkit")
 def main() -> None:
     """brdfkit: physically plausible reflectance models (BRDFs).
@@ -55,17 +67,3 @@ def main() -> None:
     Angles are in degrees on the command line. Run 'brdfkit COMMAND --help'
     for a command's options.
     """
-
-
-main.add_command(models_cmd)
-main.add_command(eval_cmd)
-main.add_command(albedo_cmd)
-main.add_command(check_cmd)
-main.add_command(table2_cmd)
-main.add_command(figure_cmd)
-main.add_command(materials_cmd)
-main.add_command(export_cmd)
-main.add_command(explore_cmd)
-render_group.add_command(sphere_cmd)
-main.add_command(render_group)
-main.add_command(fit_cmd)

@@ -12,11 +12,15 @@
   BaseException`` blocks run — the atomic figure writer removes its temp
   file — instead of the process dying on the spot. The previous handler is
   restored afterwards (the group may run inside another program or a test).
+- Commands may be registered lazily (``lazy={name: "module:attribute"}``): the
+  module is imported when the command is looked up, so a command pays only
+  for its own imports.
 """
 
 from __future__ import annotations
 
 import contextlib
+import importlib
 import signal
 import threading
 
@@ -84,6 +88,22 @@ class BrdfkitGroup(click.Group):
     :meth:`invoke`. Both convert them to :class:`OneLineError`, which click's
     ``main`` shows and exits with.
     """
+
+    def __init__(self, *args, lazy: dict[str, str] | None = None, **kwargs):
+        super().__init__(*args, **kwargs)
+        #: command name -> "module:attribute", imported when the command is looked up
+        #: (`brdfkit fit` need not import the renderer, SciPy's interpolators or
+        #: matplotlib: ~1 s of a one-line command).
+        self.lazy = dict(lazy or {})
+
+    def list_commands(self, ctx):
+        return sorted(set(super().list_commands(ctx)) | set(self.lazy))
+
+    def get_command(self, ctx, cmd_name):
+        if cmd_name not in self.commands and cmd_name in self.lazy:
+            module, _, attribute = self.lazy[cmd_name].partition(":")
+            self.add_command(getattr(importlib.import_module(module), attribute), cmd_name)
+        return super().get_command(ctx, cmd_name)
 
     def make_context(self, info_name, args, parent=None, **extra):
         try:

@@ -47,7 +47,7 @@ def render_group() -> None:
     """Render images of a model (exact sphere test configuration)."""
 
 
-@click.command("sphere")
+@render_group.command("sphere")
 @model_options
 @click.option("--phi-l", "phi_l", type=float, required=True, metavar="DEG",
               help="Angle between the light and the view direction, DEGREES in [0, 180]; the "

@@ -25,13 +25,14 @@ from the L2 solution, warm-started from the previous solution
 
 from __future__ import annotations
 
+import copy
 import math
 import warnings
 
 import numpy as np
 
 from brdfkit.errors import BrdfkitError
-from brdfkit.fitting._linear import solve_channel
+from brdfkit.fitting._linear import solve_channels
 from brdfkit.fitting.losses import NGAN_THETA_MAX_DEG, loss_value
 from brdfkit.fitting.samples import albedo_from_values, albedo_nodes
 
@@ -57,6 +58,7 @@ class Problem:
         self.n_invalid = 0
         self._warm = None  # the last linear solution (IRLS warm start)
         self.static: dict = {}  # shape-independent f₀ ('') and bases (by name)
+        self._r_static = None  # y − f₀ for a static f₀
         s = samples
         self.w = s.weight
         self.cos = s.cos_i[:, None]
@@ -68,13 +70,27 @@ class Problem:
             self.samples = s = s.subset(ok)
             self.w, self.cos, y = s.weight, s.cos_i[:, None], y[ok]
         self.y = y * self.cos
+        self._w_sum = float(np.sum(self.w))
         self.ngan_mask = ((s.wi[:, 2] >= math.cos(math.radians(NGAN_THETA_MAX_DEG)))
                           & (s.wo[:, 2] >= math.cos(math.radians(NGAN_THETA_MAX_DEG))))
         self.albedo_t = None
         if loss == "perceptual":
-            self._anodes = albedo_nodes(PERCEPTUAL_THETA_DEG, n_u=24, n_phi=12)
-            wi, wo, wa, T = self._anodes
-            self.albedo_t = albedo_from_values(self._values(target, wi, wo), wa, T)
+            self._perceptual_albedo(target)
+
+    def _perceptual_albedo(self, target) -> None:
+        self._anodes = albedo_nodes(PERCEPTUAL_THETA_DEG, n_u=24, n_phi=12)
+        wi, wo, wa, T = self._anodes
+        self.albedo_t = albedo_from_values(self._values(target, wi, wo), wa, T)
+
+    def perceptual(self, target) -> Problem:
+        """This problem under the ``perceptual`` loss (the samples and target values
+        shared, not evaluated again)."""
+        if self.loss == "perceptual":
+            return self
+        other = copy.copy(self)
+        other.loss = "perceptual"
+        other._perceptual_albedo(target)
+        return other
 
     # ------------------------------------------------------------------ evaluation
     def _values(self, m, wi, wo) -> np.ndarray:
@@ -139,10 +155,15 @@ class Problem:
             if Bk is None:
                 v = dict(zero)
                 v[name] = unit
-                _, fk = self.predict(v)
-                if fk is None:
+                m = self.build(v)
+                if m is None:
                     return None
-                Bk = (fk - f0) / unit
+                self.n_evals += 1
+                # (N, 1) for a model without per-channel parameters left: broadcast by the
+                # subtraction instead of repeated per channel first (the search's hot path)
+                fk = np.asarray(m.eval(self.samples.wi, self.samples.wo),
+                                dtype=np.float64).reshape(len(self.cos), -1) * self.cos
+                Bk = fk - f0 if unit == 1.0 else (fk - f0) / unit
             B.append(Bk)
         return f0, B
 
@@ -150,6 +171,7 @@ class Problem:
         """Mark f₀ and the bases that are identical at *values* and at the shape
         parameters *moved* as static (evaluated once; see :meth:`bases`)."""
         self.static = {}
+        self._r_static = None
         a = self.bases(values, linear)
         b = self.bases(moved, linear)
         if a is None or b is None:
@@ -179,17 +201,23 @@ class Problem:
         return float(np.max(np.abs(got_f - expect))) <= LINEAR_RTOL * scale
 
     def solve_linear(self, f0, B, lo, hi, loss: str, *,
-                     iterations: int = IRLS_ITERATIONS) -> np.ndarray:
-        """Per-channel linear parameters (K, C) minimising the L1 (``l1``, at most
-        *iterations* IRLS steps) or L2 (other losses) norm
-        (:func:`brdfkit.fitting._linear.solve_channel`)."""
-        P = np.empty((len(B), self.C))
-        for c in range(self.C):
-            A = np.ascontiguousarray(np.stack([Bk[:, c] for Bk in B], axis=1))
-            r = np.ascontiguousarray(self.y[:, c] - f0[:, c])
-            start = self._warm[:, c] if self._warm is not None and self._warm.shape == P.shape \
-                else np.empty(0)
-            P[:, c] = solve_channel(A, r, self.w, lo, hi, loss == "l1", iterations,
-                                    np.ascontiguousarray(start))
+                     iterations: int = IRLS_ITERATIONS) -> tuple[np.ndarray, float | None]:
+        """Per-channel linear parameters P (K, C) minimising the L1 (``l1``, at most
+        *iterations* IRLS steps) or L2 (other losses) norm, and the loss at P for ``l1``
+        and ``l2`` (None for the other losses: their value needs the prediction)
+        (:func:`brdfkit.fitting._linear.solve_channels`)."""
+        K = len(B)
+        start = (self._warm if self._warm is not None and self._warm.shape == (K, self.C)
+                 else np.empty((0, 0)))
+        if f0 is self.static.get(""):  # a shape-independent offset: y − f₀ once
+            if self._r_static is None:
+                self._r_static = np.ascontiguousarray(self.y - f0)
+            R = self._r_static
+        else:
+            R = np.ascontiguousarray(self.y - f0)
+        P, total = solve_channels(np.stack(B), R, self.w, lo, hi, loss == "l1", iterations,
+                                  start)
         self._warm = P.copy()
-        return P
+        # the normalisation of losses.loss_value: Σ w |d| / (Σ w · C)
+        value = total / (self._w_sum * self.C) if loss in ("l1", "l2") else None
+        return P, value

@@ -102,10 +102,10 @@ from dataclasses import dataclass, field
 
 import numba
 import numpy as np
-from scipy.optimize import minimize
 
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.fitting._problem import IRLS_ITERATIONS, Problem
+from brdfkit.fitting._simplex import nelder_mead
 from brdfkit.fitting._pumped import hold_scale
 from brdfkit.fitting._space import Z_MAX, Coord, as_vector, from_vector
 from brdfkit.fitting.losses import LOSSES
@@ -293,9 +293,7 @@ def _nelder_mead(fun, z0, steps, maxfev, scale, fatol):
         simplex = np.vstack([zs] + [zs + np.eye(n)[k] * h[k] for k in range(n)])
         try:
             with np.errstate(invalid="ignore"):  # inf − inf at refused vertices: not a stop
-                minimize(f, zs, method="Nelder-Mead",
-                         options={"initial_simplex": simplex, "maxfev": maxfev - st["n"],
-                                  "xatol": math.inf, "fatol": fatol, "adaptive": n > 2})
+                nelder_mead(f, simplex, maxfev=maxfev - st["n"], fatol=fatol, adaptive=n > 2)
         except _Stalled:
             pass
         if before - st["best"] <= fatol or st["n"] >= maxfev:
@@ -433,8 +431,10 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
     if scan_width:
         values = _with_width(values, wp, width_from_beta, beta)
 
-    # parameters that change nothing are held (and reported)
-    inert = _inert(prob, coords, values)
+    # parameters that change nothing are held (and reported); tested on the search's
+    # samples (every θ_h bin), as the linearity below: properties of the model, not of
+    # the sample density, and a third of the cost
+    inert = _inert(sp, coords, values)
     coords = [c for c in coords if c.name not in inert]
     record["inert"] = sorted(inert)
 
@@ -445,8 +445,8 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
     if procedure != "direct":
         cand = [(p.name, min(1.0, p.upper)) for p in model.params
                 if p.kind == "colour" and any(c.name == p.name for c in coords)]
-        cand = [c for c in cand if prob.is_affine(values, [c], rng)]
-        if len(cand) == 1 or (cand and prob.is_affine(values, cand, rng)):
+        cand = [c for c in cand if sp.is_affine(values, [c], rng)]
+        if len(cand) == 1 or (cand and sp.is_affine(values, cand, rng)):
             linear = cand
     lin_names = [n for n, _ in linear]
     record["linear"] = lin_names
@@ -461,33 +461,26 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
             p.find_static(values, linear, moved)
     record["static_bases"] = sorted(k or "f0" for k in prob.static)
 
-    def project(p, vals, iterations=IRLS_ITERATIONS):
-        """(*vals* with the linear parameters solved on problem *p*, the model's values
-        from the bases), or None when refused."""
+    def solve_at(p, vals, want_loss=False, iterations=IRLS_ITERATIONS):
+        """*vals* with the linear parameters solved on problem *p* (and its loss)."""
         got = p.bases(vals, linear) if linear else None
         if got is None:
-            return None
+            return (None, math.inf) if want_loss else None
         f0, B = got
-        P = p.solve_linear(f0, B, lo, hi, loss, iterations=iterations)
+        P, value = p.solve_linear(f0, B, lo, hi, loss, iterations=iterations)
         out = dict(vals)
         for k, n in enumerate(lin_names):
             out[n] = P[k].copy() if C > 1 else float(P[k, 0])
+        if not want_loss:
+            return out
+        if value is not None:  # l1, l2: computed with the solve
+            return out, value
+        if loss == "perceptual":  # needs the model's albedo: evaluate it
+            return out, p.loss_at(out)
         # the model is affine in the linear parameters: its values from the bases
         pred = f0.copy()
         for k, Bk in enumerate(B):
             pred += Bk * P[k][None, :]
-        return out, pred
-
-    def solve_at(p, vals, want_loss=False, iterations=IRLS_ITERATIONS):
-        """*vals* with the linear parameters solved on problem *p* (and its loss)."""
-        got = project(p, vals, iterations)
-        if got is None:
-            return (None, math.inf) if want_loss else None
-        out, pred = got
-        if not want_loss:
-            return out
-        if loss == "perceptual":  # needs the model's albedo: evaluate it
-            return out, p.loss_at(out)
         return out, p.loss_of(None, pred)
 
     def search(p, free, v0, projecting, budget, steps, fatol):
@@ -680,7 +673,10 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
                                 else "shape, linear re-solved (= all jointly)" if projected3
                                 else "all"), [c.label for c in free3], n0, before,
                      min(val, before), limit, values)
-    values, flat = _flat_to_bound(prob, values, coords)
+    # linear parameters solved exactly in a box (variable projection to the end) sit at a
+    # bound exactly when it is active: the exact test of _result finds them, not this one
+    solved = set(lin_names) if projected3 else set()
+    values, flat = _flat_to_bound(prob, values, [c for c in coords if c.name not in solved])
     if free3 and hit_limit:
         # the polish was still crawling, typically towards a bound approached only
         # asymptotically in z: the coordinates at (or indistinguishable from) a bound are
@@ -702,7 +698,8 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
                 val = prob.loss_at(end)
             if val <= before:
                 values, hit_limit = end, limit
-                values, flat = _flat_to_bound(prob, values, coords)
+                values, flat = _flat_to_bound(prob, values,
+                                              [c for c in coords if c.name not in solved])
             elif not limit:  # stopped by the tolerance without a gain: a converged point
                 hit_limit = False
             stage_record("iii': polish with " + ", ".join(c.label for c in held)
@@ -805,8 +802,7 @@ def _result(prob, target, values, coords, record, hit_limit, t_start, flat,
     metrics = {}
     for name in ("l1", "l2", "ngan", "log", "perceptual"):
         if name == "perceptual" and prob.albedo_t is None:
-            p2 = Problem(prob.model, target, prob.samples, "perceptual", prob.C)
-            metrics[name] = p2.loss_of(m, pred)
+            metrics[name] = prob.perceptual(target).loss_of(m, pred)
         else:
             metrics[name] = prob.loss_of(m, pred, name)
     wi, wo, wa, T = albedo_nodes(ALBEDO_THETA_DEG)

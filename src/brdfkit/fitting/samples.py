@@ -57,6 +57,7 @@ target are integrated with the same nodes.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -135,6 +136,19 @@ def merl_samples(*, strides=DEFAULT_STRIDES, theta_max=None) -> Samples:
                              f"{tuple(strides)}")
     if theta_max is not None and not (0.0 < float(theta_max) <= 0.5 * math.pi):
         raise ParameterError(f"theta_max must lie in (0, pi/2] rad; got {theta_max!r}")
+    return _merl_samples(sd, sp, None if theta_max is None else float(theta_max))
+
+
+def _read_only(*arrays):
+    for a in arrays:
+        a.flags.writeable = False
+    return arrays
+
+
+# Memoised (every fit of a batch, and each fit's nested and root fits, uses the same few
+# grids; building one costs ~3 ms): the arrays are shared, hence read-only.
+@functools.lru_cache(maxsize=16)
+def _merl_samples(sd: int, sp: int, theta_max: float | None) -> Samples:
     h, d, p = _edges()
     d_c, p_c = d[::sd], p[::sp]
     W = bin_measure(h, d_c, p_c)
@@ -158,7 +172,7 @@ def merl_samples(*, strides=DEFAULT_STRIDES, theta_max=None) -> Samples:
     # allows 1e-3, so this only removes the rounding
     wi /= np.linalg.norm(wi, axis=1, keepdims=True)
     wo /= np.linalg.norm(wo, axis=1, keepdims=True)
-    return Samples(wi, wo, W[keep], wi[:, 2].copy())
+    return Samples(*_read_only(wi, wo, W[keep], wi[:, 2].copy()))
 
 
 def albedo_nodes(theta_deg=ALBEDO_THETA_DEG, *, n_u: int = 48, n_phi: int = 24):
@@ -167,7 +181,14 @@ def albedo_nodes(theta_deg=ALBEDO_THETA_DEG, *, n_u: int = 48, n_phi: int = 24):
     Returns ``(wi, wo, w, T)``: pairs (T·n_u·n_phi, 3) and weights w such that
     a(θ_t) ≈ Σ_k w_k f(wi_k, wo_k) over the t-th block of n_u·n_phi pairs (w is 0
     where ω_o is below the horizon; such pairs are given ω_o = n to stay valid).
+    The arrays are read-only (memoised: shared by every call with the same nodes).
     """
+    theta = tuple(float(t) for t in np.atleast_1d(np.asarray(theta_deg, dtype=np.float64)))
+    return _albedo_nodes(theta, int(n_u), int(n_phi))
+
+
+@functools.lru_cache(maxsize=16)
+def _albedo_nodes(theta_deg: tuple, n_u: int, n_phi: int):
     theta = np.radians(np.asarray(theta_deg, dtype=np.float64))
     u = (np.arange(n_u) + 0.5) / n_u
     th = u * u * (0.5 * math.pi)
@@ -190,8 +211,9 @@ def albedo_nodes(theta_deg=ALBEDO_THETA_DEG, *, n_u: int = 48, n_phi: int = 24):
         wis.append(np.broadcast_to(wi, wo.shape))
         wos.append(wo)
         ws.append(w)
-    return (np.ascontiguousarray(np.concatenate(wis)), np.ascontiguousarray(np.concatenate(wos)),
-            np.concatenate(ws), theta.size)
+    return (*_read_only(np.ascontiguousarray(np.concatenate(wis)),
+                        np.ascontiguousarray(np.concatenate(wos)), np.concatenate(ws)),
+            theta.size)
 
 
 def albedo_from_values(f, w, n_theta: int) -> np.ndarray:

@@ -49,6 +49,7 @@ from brdfkit._array import as_directions, as_uniform
 from brdfkit._dual import Formulas
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models.sampling import COSINE
+from brdfkit.models._driver_cache import cached_driver
 
 __all__ = ["Param", "Lobe", "BRDF", "DerivedBRDF", "checked_driver", "eval_pairs",
            "eval_pairs_checked"]
@@ -133,6 +134,8 @@ class Param:
         """Return *value* converted (float, float array, str or None); raise if invalid."""
         if value is None and self.optional:
             return None
+        if type(value) is float and self.kind != "choice" and self._inside(value):
+            return value  # the common case (a fit builds a model per evaluation): no array
         if self.kind == "choice":
             if not isinstance(value, str) or value.lower() not in self.choices:
                 raise ParameterError(
@@ -224,7 +227,7 @@ def eval_pairs(kernel, wi, wo, P, out):  # pragma: no cover - compiled
 #: thousand pairs cost ~0.1 ms serially, and on a loaded 2-core machine the OpenMP barrier
 #: of a parallel region waits for a descheduled worker for milliseconds (the explorer's
 #: 181-point slices took 16 ms instead of 0.1 ms under a load of 5).
-SERIAL_BELOW = 4096
+SERIAL_BELOW = 2048
 UNIT_TOL = 1e-3
 
 
@@ -701,8 +704,14 @@ class BRDF:
         if wi2.shape[0] < SERIAL_BELOW:
             numba.set_num_threads(1)  # thread-local: only this call's parallel regions
         try:
-            n_bad = (driver(wi2, wo2, self._driver_data(), out) if driver is not None
-                     else eval_pairs_checked(self.kernel, wi2, wo2, self._packed, out))
+            if driver is not None:
+                n_bad = driver(wi2, wo2, self._driver_data(), out)
+            else:
+                # the generic loop, compiled once per kernel and kept on disk when the
+                # kernel has an importable name (models/_driver_cache.py)
+                cached = cached_driver(self.kernel)
+                n_bad = (cached(wi2, wo2, self._packed, out) if cached is not None
+                         else eval_pairs_checked(self.kernel, wi2, wo2, self._packed, out))
         finally:
             numba.set_num_threads(threads)
         if n_bad:
