@@ -1,6 +1,6 @@
 """``python -m brdfkit`` runs the command line (same as the ``brdfkit`` script)."""
 
-from brdfkit.cli import main
+from brdfkit.cli import run
 
 if __name__ == "__main__":
-    main(prog_name="brdfkit")
+    run()

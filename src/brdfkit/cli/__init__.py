@@ -29,17 +29,23 @@ imported when looked up, so each command pays only for its own imports).
 
 Public objects
 --------------
-- :data:`main` — the click group (entry point ``brdfkit``).
+- :data:`main` — the click group.
+- :func:`run` — the ``brdfkit`` console script and ``python -m brdfkit``: ``main``
+  with a fast exit.
 """
 
 from __future__ import annotations
+
+import atexit
+import os
+import sys
 
 import click
 
 import brdfkit
 from brdfkit.cli._group import BrdfkitGroup
 
-__all__ = ["main"]
+__all__ = ["main", "run"]
 
 
 #: command name -> where it is defined; imported only when the command is looked up
@@ -67,3 +73,32 @@ def main() -> None:
     Angles are in degrees on the command line. Run 'brdfkit COMMAND --help'
     for a command's options.
     """
+
+
+def run() -> None:
+    """The ``brdfkit`` console script: :data:`main`, then a fast exit.
+
+    When the command has finished (its output written and flushed, its ``finally``
+    blocks run), the atexit handlers run and the process ends with ``os._exit``,
+    skipping the interpreter's teardown of every module: with Numba and LLVM loaded that
+    teardown took 0.2-0.6 s (measured), a quarter of a one-line ``brdfkit fit``. Nothing
+    is lost: no output is pending, and atexit cleanups (e.g. multiprocessing's) still
+    run. An exception other than SystemExit propagates as usual (a bug: its traceback).
+    """
+    try:
+        main(prog_name="brdfkit")
+        code = 0
+    except SystemExit as exc:
+        code = exc.code
+    if code is None:
+        code = 0
+    elif not isinstance(code, int):  # sys.exit("message"): printed, status 1
+        print(code, file=sys.stderr)
+        code = 1
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a closed pipe (e.g. '| head'): nothing to flush to
+            pass
+    os._exit(code)

@@ -105,8 +105,8 @@ import numpy as np
 
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.fitting._problem import IRLS_ITERATIONS, Problem
-from brdfkit.fitting._simplex import nelder_mead
 from brdfkit.fitting._pumped import hold_scale
+from brdfkit.fitting._simplex import nelder_mead
 from brdfkit.fitting._space import Z_MAX, Coord, as_vector, from_vector
 from brdfkit.fitting.losses import LOSSES
 from brdfkit.fitting.samples import (

@@ -48,8 +48,8 @@ import numpy as np
 from brdfkit._array import as_directions, as_uniform
 from brdfkit._dual import Formulas
 from brdfkit.errors import BrdfkitError, ParameterError
-from brdfkit.models.sampling import COSINE
 from brdfkit.models._driver_cache import cached_driver
+from brdfkit.models.sampling import COSINE
 
 __all__ = ["Param", "Lobe", "BRDF", "DerivedBRDF", "checked_driver", "eval_pairs",
            "eval_pairs_checked"]
