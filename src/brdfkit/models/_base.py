@@ -227,7 +227,7 @@ def eval_pairs(kernel, wi, wo, P, out):  # pragma: no cover - compiled
 #: thousand pairs cost ~0.1 ms serially, and on a loaded 2-core machine the OpenMP barrier
 #: of a parallel region waits for a descheduled worker for milliseconds (the explorer's
 #: 181-point slices took 16 ms instead of 0.1 ms under a load of 5).
-SERIAL_BELOW = 2048
+SERIAL_BELOW = 4096
 UNIT_TOL = 1e-3
 
 
