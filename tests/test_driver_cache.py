@@ -1,4 +1,4 @@
-"""The disk-cached evaluation loops (brdfkit.models._driver_cache).
+"""The disk-cached evaluation loops (brdfkit.models._drivers).
 
 References: the generic loop eval_pairs_checked (bit-equal results: the same code with the
 kernel a global instead of an argument) and Numba's own cache statistics (a second process
@@ -19,7 +19,7 @@ import pytest
 
 import brdfkit
 from brdfkit.models._base import eval_pairs_checked
-from brdfkit.models._driver_cache import cache_dir, cached_driver
+from brdfkit.models._drivers import cache_dir, cached_driver
 
 
 def _pairs(n, seed=0):
@@ -59,7 +59,7 @@ def test_a_kernel_without_an_importable_name_keeps_the_generic_loop():
 
 _CHILD = textwrap.dedent("""
     import json, numpy as np, brdfkit
-    from brdfkit.models._driver_cache import cached_driver
+    from brdfkit.models._drivers import cached_driver
     m = brdfkit.model("modified-blinn-phong", n=30.0)
     wi = np.array([[0.0, 0.6, 0.8]]); wo = np.array([[0.0, -0.6, 0.8]])
     value = float(m.eval(wi, wo)[0])

@@ -27,12 +27,9 @@ Public objects
 - :class:`Param` — a declared parameter.
 - :class:`BRDF` — the base class of all models; it declares the model protocol.
 - :class:`DerivedBRDF` — the one constructor path for models built from others.
-- :func:`eval_pairs` — the compiled driver (for code that has packed arrays).
-- :func:`eval_pairs_checked` — the same, also testing in the same pass that the
-  directions are finite unit vectors (what :meth:`BRDF.eval` uses).
-- :func:`checked_driver` — :func:`eval_pairs_checked` compiled for one kernel,
-  inlined (composite kernels such as pumped models'; with ``vectorise=True``
-  the vectorised loop of branch-free kernels such as the microfacet models').
+- :func:`eval_pairs`, :func:`eval_pairs_checked`, :func:`checked_driver` — the
+  compiled loops over all pairs, defined in :mod:`brdfkit.models._drivers` and
+  imported here (the loop :meth:`BRDF.eval` runs: :func:`~brdfkit.models._drivers.cached_driver`).
 """
 
 from __future__ import annotations
@@ -48,7 +45,16 @@ import numpy as np
 from brdfkit._array import as_directions, as_uniform
 from brdfkit._dual import Formulas
 from brdfkit.errors import BrdfkitError, ParameterError
-from brdfkit.models._driver_cache import cached_driver
+from brdfkit.models._drivers import (  # noqa: F401  (re-exported: models import them here)
+    SERIAL_BELOW,
+    UNIT_TOL,
+    VECTOR_OPTIONS,
+    _unit_pair,
+    cached_driver,
+    checked_driver,
+    eval_pairs,
+    eval_pairs_checked,
+)
 from brdfkit.models.sampling import COSINE
 
 __all__ = ["Param", "Lobe", "BRDF", "DerivedBRDF", "checked_driver", "eval_pairs",
@@ -188,204 +194,6 @@ def _fmt(x: float) -> str:
     if math.isinf(x):
         return "inf" if x > 0 else "-inf"
     return f"{x:g}"
-
-
-# Not cached on disk: a specialisation is keyed on the kernel's dispatcher, which is new
-# in every process, so an on-disk entry could never be reused (and Numba fails to re-save
-# an index holding dead dispatchers). The kernels themselves are cached; compiling this
-# loop around one costs ~0.5-1 s once per process and model.
-@numba.njit(parallel=True)
-def eval_pairs(kernel, wi, wo, P, out):  # pragma: no cover - compiled
-    """out[j, c] = kernel(wi[j], wo[j], P[c]) for all pairs j and channels c.
-
-    ``wi``, ``wo``: (N, 3) C-contiguous float64; ``P``: (C, K) packed
-    parameters; ``out``: (N, C).
-    """
-    n = wi.shape[0]
-    n_channels = P.shape[0]
-    if n_channels == 1:
-        # the common case, with the parameter row hoisted out of the loop
-        p = P[0]
-        for j in numba.prange(n):
-            out[j, 0] = kernel(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2], p)
-    else:
-        for j in numba.prange(n):
-            for c in range(n_channels):
-                out[j, c] = kernel(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2],
-                                   P[c])
-
-
-# Directions must be unit vectors: |‖w‖² − 1| ≤ UNIT_TOL, tested in the compiled pass (the
-# same read of the data as the NaN/inf test, which it subsumes: comparisons with NaN are
-# false and ‖w‖² of an infinite component is inf). 1e-3 on the squared norm (5e-4 on the
-# norm): directions normalised in float32 (within ~4e-7) and vectors typed with three or
-# four digits, such as (0.2, 0, −0.98) with ‖w‖² = 1.0004, pass; a vector scaled by mistake
-# (‖w‖ = 2), an unnormalised sum or difference of directions, or a half-converted angle
-# does not. The check guards against mistakes, not rounding: the kernels take the
-# components as given.
-#: Calls with fewer pairs run their parallel region on the calling thread alone: a few
-#: thousand pairs cost ~0.1 ms serially, and on a loaded 2-core machine the OpenMP barrier
-#: of a parallel region waits for a descheduled worker for milliseconds (the explorer's
-#: 181-point slices took 16 ms instead of 0.1 ms under a load of 5).
-SERIAL_BELOW = 4096
-UNIT_TOL = 1e-3
-
-
-@numba.njit(inline="always")
-def _unit_pair(ix, iy, iz, ox, oy, oz) -> bool:
-    """Both directions finite with |‖w‖² − 1| ≤ UNIT_TOL (False for NaN or inf)."""
-    return ((abs(ix * ix + iy * iy + iz * iz - 1.0) <= UNIT_TOL)
-            & (abs(ox * ox + oy * oy + oz * oz - 1.0) <= UNIT_TOL))
-
-
-# Compile options of the vectorising drivers (checked_driver(..., vectorise=True)): a kernel
-# inlined into them is compiled with the driver's options, so these are the kernel's.
-# error_model="numpy": IEEE division (no zero-divisor test, which would be a branch);
-# no fastmath flags: not even "contract" (fused multiply-adds), which LLVM applies
-# differently in the vector body and the scalar remainder, so one pair's value depended on
-# its position in the array by an ulp (tests/test_registry_properties.py, broadcasting).
-VECTOR_OPTIONS = {"error_model": "numpy", "fastmath": set()}
-_CHUNK = 4096  # pairs per task of the vectorised drivers (96 KiB of directions)
-
-
-def checked_driver(kernel, *, vectorise: bool = False):
-    """:func:`eval_pairs_checked` specialised to one *kernel* (a new compiled function).
-
-    :func:`eval_pairs_checked` calls its kernel through a first-class function
-    argument, which LLVM inlines only when the kernel is small; a composite
-    kernel (a pumped model: the base kernel plus table lookups) then stays an
-    out-of-line call per pair, with its packed-array argument spilled to the
-    stack. Here the kernel is a closure variable, so Numba inlines it into the
-    loop when it is declared ``inline="always"``. Measured on 10 M pairs: a
-    pumped Phong at the base model's speed instead of 1.2-1.6x slower. A model
-    opts in by setting its ``_driver`` attribute (see :meth:`BRDF.eval`).
-
-    ``vectorise=True`` is for kernels written branch-free and *total*: for any
-    input values (NaN, inf, non-unit) they return without side effects and
-    read memory only in bounds (see :mod:`brdfkit._kern`). The driver then
-    evaluates every pair and selects NaN for the rejected ones instead of
-    branching around the kernel, so that LLVM vectorises the loop (4 float64
-    lanes with AVX2), and is compiled with :data:`VECTOR_OPTIONS`. The
-    directions are read as flat arrays (index 3j + k), which LLVM loads as
-    interleaved groups; measured on 10 M pairs (microfacet, Beckmann α = 0.1):
-    2.3x the generic loop on one thread.
-    """
-
-    # eval_pairs_checked's loop written out again on purpose: with one shared
-    # inline="always" body called from both, the kernel became a variable of the inlined
-    # body instead of this closure's and was no longer inlined (measured on 10 M pairs:
-    # 4-20 % slower, as slow as the generic loop).
-    if vectorise:
-        @numba.njit(**VECTOR_OPTIONS)
-        def chunk(a, b, o, p):  # pragma: no cover - compiled
-            # One channel of the pairs in a and b (flat, 3 per pair) into o; returns the
-            # number of good pairs. What LLVM needs to vectorise this loop, each measured:
-            # its own function (inside the prange body Numba keeps the loop's variables
-            # live after it), indices from 0 (a signed start needs the negative-index
-            # wraparound select, and the loads are no longer an interleaved group),
-            # a unit-stride store, and the count as int64(ok) (not a select of 0 and 1).
-            good = 0
-            for j in range(o.shape[0]):
-                ix, iy, iz = a[3 * j], a[3 * j + 1], a[3 * j + 2]
-                ox, oy, oz = b[3 * j], b[3 * j + 1], b[3 * j + 2]
-                ok = _unit_pair(ix, iy, iz, ox, oy, oz)
-                v = kernel(ix, iy, iz, ox, oy, oz, p)  # total: safe for any input
-                o[j] = v if ok else math.nan
-                good += numba.int64(ok)
-            return good
-
-        @numba.njit(parallel=True, **VECTOR_OPTIONS)
-        def vector_driver(wi, wo, P, out):  # pragma: no cover - compiled
-            n = wi.shape[0]
-            n_channels = P.shape[0]
-            a = wi.reshape(3 * n)
-            b = wo.reshape(3 * n)
-            n_chunks = (n + _CHUNK - 1) // _CHUNK
-            n_good = 0
-            if n_channels == 1:
-                o = out.reshape(n)
-                p = P[0]
-                for q in numba.prange(n_chunks):
-                    lo = q * _CHUNK
-                    hi = min(n, lo + _CHUNK)
-                    n_good += chunk(a[3 * lo:3 * hi], b[3 * lo:3 * hi], o[lo:hi], p)
-                return n - n_good
-            col = np.empty(n)  # one channel at a time, then strided into out
-            for c in range(n_channels):
-                p = P[c]
-                for q in numba.prange(n_chunks):
-                    lo = q * _CHUNK
-                    hi = min(n, lo + _CHUNK)
-                    n_good += chunk(a[3 * lo:3 * hi], b[3 * lo:3 * hi], col[lo:hi], p)
-                out[:, c] = col
-            return n - n_good // n_channels
-
-        return vector_driver
-
-    @numba.njit(parallel=True)
-    def driver(wi, wo, P, out):  # pragma: no cover - compiled
-        n = wi.shape[0]
-        n_channels = P.shape[0]
-        n_bad = 0
-        if n_channels == 1:
-            p = P[0]  # hoisted, as in eval_pairs_checked
-            for j in numba.prange(n):
-                ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
-                ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-                if _unit_pair(ix, iy, iz, ox, oy, oz):
-                    out[j, 0] = kernel(ix, iy, iz, ox, oy, oz, p)
-                else:
-                    out[j, 0] = math.nan
-                    n_bad += 1
-        else:
-            for j in numba.prange(n):
-                ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
-                ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-                ok = _unit_pair(ix, iy, iz, ox, oy, oz)
-                for c in range(n_channels):
-                    out[j, c] = kernel(ix, iy, iz, ox, oy, oz, P[c]) if ok else math.nan
-                if not ok:
-                    n_bad += 1
-        return n_bad
-
-    return driver
-
-
-@numba.njit(parallel=True)
-def eval_pairs_checked(kernel, wi, wo, P, out):  # pragma: no cover - compiled
-    """:func:`eval_pairs` that also tests the directions in the same pass.
-
-    Pairs with a non-finite component or a direction that is not a unit
-    vector (|‖w‖² − 1| > :data:`UNIT_TOL`) are not passed to the kernel (their
-    ``out`` rows are NaN). Returns the number of such pairs, so that the
-    caller can raise; reading the directions once instead of twice is what
-    makes this faster than ``np.isfinite`` followed by :func:`eval_pairs`.
-    """
-    n = wi.shape[0]
-    n_channels = P.shape[0]
-    n_bad = 0
-    if n_channels == 1:
-        p = P[0]
-        for j in numba.prange(n):
-            ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
-            ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-            if _unit_pair(ix, iy, iz, ox, oy, oz):
-                out[j, 0] = kernel(ix, iy, iz, ox, oy, oz, p)
-            else:
-                out[j, 0] = math.nan
-                n_bad += 1
-    else:
-        for j in numba.prange(n):
-            ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
-            ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-            if _unit_pair(ix, iy, iz, ox, oy, oz):
-                for c in range(n_channels):
-                    out[j, c] = kernel(ix, iy, iz, ox, oy, oz, P[c])
-            else:
-                for c in range(n_channels):
-                    out[j, c] = math.nan
-                n_bad += 1
-    return n_bad
 
 
 class BRDF:
@@ -708,7 +516,7 @@ class BRDF:
                 n_bad = driver(wi2, wo2, self._driver_data(), out)
             else:
                 # the generic loop, compiled once per kernel and kept on disk when the
-                # kernel has an importable name (models/_driver_cache.py)
+                # kernel has an importable name (models/_drivers.py)
                 cached = cached_driver(self.kernel)
                 n_bad = (cached(wi2, wo2, self._packed, out) if cached is not None
                          else eval_pairs_checked(self.kernel, wi2, wo2, self._packed, out))
