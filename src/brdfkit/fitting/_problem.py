@@ -207,6 +207,9 @@ class Problem:
         and ``l2`` (None for the other losses: their value needs the prediction)
         (:func:`brdfkit.fitting._linear.solve_channels`)."""
         K = len(B)
+        # bounds per parameter (K,) or per parameter and channel (K, C)
+        lo = np.ascontiguousarray(np.broadcast_to(np.reshape(lo, (K, -1)), (K, self.C)))
+        hi = np.ascontiguousarray(np.broadcast_to(np.reshape(hi, (K, -1)), (K, self.C)))
         start = (self._warm if self._warm is not None and self._warm.shape == (K, self.C)
                  else np.empty((0, 0)))
         if f0 is self.static.get(""):  # a shape-independent offset: y − f₀ once

@@ -16,6 +16,9 @@ before): the same evaluations in the same order, so the same result —
 is here, 60 lines, because importing :mod:`scipy.optimize` costs ~0.5 s, a
 quarter of a one-line ``brdfkit fit``.
 
+:func:`search_simplex` is the procedure's use of it: a run from a point with given
+steps, stopped also when it stalls, its stop checked by one restart.
+
 References
 ----------
 - J. A. Nelder, R. Mead, *A simplex method for function minimization*, The
@@ -26,9 +29,17 @@ References
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-__all__ = ["nelder_mead"]
+__all__ = ["nelder_mead", "search_simplex", "NM_RESTARTS", "STALL_EVALS"]
+
+#: Restarts of a Nelder–Mead run from its best point (see search_simplex).
+NM_RESTARTS = 1
+#: A Nelder–Mead run stops after this many evaluations per coordinate without a
+#: significant improvement (see search_simplex).
+STALL_EVALS = 10
 
 
 class _Budget(Exception):
@@ -100,3 +111,54 @@ def nelder_mead(fun, simplex, *, maxfev: int, fatol: float, adaptive: bool = Fal
         order = np.argsort(fsim)
         sim, fsim = np.take(sim, order, 0), np.take(fsim, order, 0)
     return sim[0], float(np.min(fsim)), calls[0]
+
+
+class _Stalled(Exception):
+    """Raised inside a Nelder–Mead run to stop it (see search_simplex)."""
+
+
+def search_simplex(fun, z0, steps, maxfev, scale, fatol):
+    """Nelder–Mead from z0 with an initial simplex of the given steps; the loss is
+    divided by *scale* (a loss near the optimum: a change below *fatol* of it is
+    negligible, also where the loss tends to 0 on exact data).
+
+    A run stops when the losses at the simplex's vertices agree to *fatol*, or when
+    :data:`STALL_EVALS` × n evaluations in a row have not lowered the best loss by more
+    than *fatol* (stalled: crawling along a flat valley, e.g. Lafortune's common scale of
+    C_xy, C_z against ρ_s, or towards a bound approached only asymptotically in z; the
+    bound is then reported by _flat_to_bound). The stop is checked by restarting once from
+    the best point with a fresh simplex of half the steps (the standard remedy for a
+    collapsed simplex: along a curved valley, e.g. Nielsen's s against α, the simplex can
+    flatten and stop short). *maxfev* evaluations in all. Returns (z, value,
+    n_evaluations, hit_limit)."""
+    z = np.asarray(z0, dtype=np.float64)
+    n = z.size
+    st = {"n": 0, "best": math.inf, "z": z, "ref": math.inf, "since": 0}
+
+    def f(x):
+        v = fun(x) / scale
+        st["n"] += 1
+        if v < st["best"]:
+            st["best"], st["z"] = v, np.array(x, dtype=np.float64)
+        if v < st["ref"] - fatol:  # a significant improvement
+            st["ref"], st["since"] = v, 0
+        else:
+            st["since"] += 1
+            if st["since"] >= STALL_EVALS * n:
+                raise _Stalled
+        return v
+
+    for run in range(1 + NM_RESTARTS):
+        before = st["best"]
+        st["ref"], st["since"] = st["best"], 0
+        h = np.asarray(steps, dtype=np.float64) * (0.5 if run else 1.0)
+        zs = st["z"]
+        simplex = np.vstack([zs] + [zs + np.eye(n)[k] * h[k] for k in range(n)])
+        try:
+            with np.errstate(invalid="ignore"):  # inf − inf at refused vertices: not a stop
+                nelder_mead(f, simplex, maxfev=maxfev - st["n"], fatol=fatol, adaptive=n > 2)
+        except _Stalled:
+            pass
+        if before - st["best"] <= fatol or st["n"] >= maxfev:
+            break
+    return st["z"], st["best"] * scale, st["n"], st["n"] >= maxfev

@@ -41,11 +41,17 @@ Stages of ``procedure="staged"`` (= ``"auto"``, any model):
     parameters where they change the model least (the z of
     :data:`NEUTRAL_Z` of least loss; for η: η → 0, F = 1 under total internal
     reflection) — so a free optional parameter never makes the fit worse;
-    the declared defaults (an optional parameter declared None keeps its
-    value); ``n_starts − 2`` random ones (z of the guess plus N(0, 1), from
-    ``numpy.random.default_rng(seed)``). Every run is recorded; once two runs
-    reach the same loss (relative difference ≤ :data:`CONSENSUS`) the
-    remaining starts are recorded as skipped.
+    for a parameter whose bounds are sub-models (``BRDF.fit_bound_starts``:
+    Nielsen's α, 0 Phong-like, 1 Blinn-like) two starts near its bounds
+    (:data:`BOUND_START_Z`), which always run; the declared defaults (an
+    optional parameter declared None keeps its value); ``n_starts − 2``
+    random ones (z of the guess plus N(0, 1), from
+    ``numpy.random.default_rng(seed)``) — ``n_starts`` starts in all besides the
+    nested one, the bound starts first after the guess. Every run is
+    recorded; once two runs reach the same loss (relative difference ≤
+    :data:`CONSENSUS`) the remaining starts (but bound starts) are recorded
+    as skipped. ``procedure="nielsen"`` compares the runs with their linear
+    parameters re-solved.
 (iii) polish on the fit's own samples from the best run: for l1, l2 and ngan
     the shape with the linear parameters re-solved — variable projection is
     exact for them (min over (shape, linear) = min over shape of the loss with
@@ -74,7 +80,7 @@ channel is held at the root's value (``convergence["scale_held"]``;
 :mod:`brdfkit.fitting._pumped`).
 
 Stopping and status: a Nelder–Mead run stops when its vertices' losses agree
-to :data:`FRTOL` of the loss after stage (i), or after :data:`STALL_EVALS`
+to :data:`FRTOL` of the loss after stage (i), or after :data:`~brdfkit.fitting._simplex.STALL_EVALS`
 evaluations per coordinate without such an improvement (a flat valley, or a
 bound approached asymptotically in z); its stop is checked by one restart
 from the best point. The status is set by the last stage: MAX_EVALS when it
@@ -106,7 +112,7 @@ import numpy as np
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.fitting._problem import IRLS_ITERATIONS, Problem
 from brdfkit.fitting._pumped import hold_scale
-from brdfkit.fitting._simplex import nelder_mead
+from brdfkit.fitting._simplex import search_simplex
 from brdfkit.fitting._space import Z_MAX, Coord, as_vector, from_vector
 from brdfkit.fitting.losses import LOSSES
 from brdfkit.fitting.samples import (
@@ -137,11 +143,6 @@ STATUS_MESSAGES = {
 #: flat directions (e.g. Lafortune's common scale of C_xy, C_z against rho_s) there is no
 #: parameter tolerance to reach.
 FRTOL, FRTOL_POLISH = 1e-4, 1e-5
-#: Restarts of a Nelder–Mead run from its best point (see _nelder_mead).
-NM_RESTARTS = 1
-#: A Nelder–Mead run stops after this many evaluations per coordinate without a
-#: significant improvement (see _nelder_mead).
-STALL_EVALS = 10
 #: Losses whose linear solve is exact (the L1 one by IRLS to convergence at the end).
 EXACT_PROJECTION = ("l1", "l2", "ngan")
 #: IRLS steps of the final L1 linear solve (the search's solves take IRLS_ITERATIONS,
@@ -165,6 +166,9 @@ BETA_LADDER_DEG = (0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0)
 #: z of the optional parameters (e.g. η) tried at the nested model's optimum: the one
 #: where the loss is least (where the parameter changes the model least) starts stage (ii).
 NEUTRAL_Z = (-Z_MAX, -6.0, -2.0, 0.0, 2.0, 6.0, Z_MAX)
+#: z (logit) of the starts near the bounds of BRDF.fit_bound_starts parameters: 1.8 % of
+#: the range from the bound, where the logit's initial step (~2.8 in z) can still leave it.
+BOUND_START_Z = 4.0
 #: A coordinate whose move to its bound changes the final loss by less than this relative
 #: amount is reported at that bound (the data cannot tell it from the bound).
 BOUND_LOSS_RTOL = 1e-4
@@ -248,57 +252,6 @@ def _measured_half_width(target) -> float:
         return math.pi / 4
     below = np.nonzero(f - floor < 0.5 * peak)[0]
     return float(th[below[0]]) if below.size else math.pi / 4
-
-
-class _Stalled(Exception):
-    """Raised inside a Nelder–Mead run to stop it (see _nelder_mead)."""
-
-
-def _nelder_mead(fun, z0, steps, maxfev, scale, fatol):
-    """Nelder–Mead from z0 with an initial simplex of the given steps; the loss is
-    divided by *scale* (a loss near the optimum: a change below *fatol* of it is
-    negligible, also where the loss tends to 0 on exact data).
-
-    A run stops when the losses at the simplex's vertices agree to *fatol*, or when
-    :data:`STALL_EVALS` × n evaluations in a row have not lowered the best loss by more
-    than *fatol* (stalled: crawling along a flat valley, e.g. Lafortune's common scale of
-    C_xy, C_z against ρ_s, or towards a bound approached only asymptotically in z; the
-    bound is then reported by _flat_to_bound). The stop is checked by restarting once from
-    the best point with a fresh simplex of half the steps (the standard remedy for a
-    collapsed simplex: along a curved valley, e.g. Nielsen's s against α, the simplex can
-    flatten and stop short). *maxfev* evaluations in all. Returns (z, value,
-    n_evaluations, hit_limit)."""
-    z = np.asarray(z0, dtype=np.float64)
-    n = z.size
-    st = {"n": 0, "best": math.inf, "z": z, "ref": math.inf, "since": 0}
-
-    def f(x):
-        v = fun(x) / scale
-        st["n"] += 1
-        if v < st["best"]:
-            st["best"], st["z"] = v, np.array(x, dtype=np.float64)
-        if v < st["ref"] - fatol:  # a significant improvement
-            st["ref"], st["since"] = v, 0
-        else:
-            st["since"] += 1
-            if st["since"] >= STALL_EVALS * n:
-                raise _Stalled
-        return v
-
-    for run in range(1 + NM_RESTARTS):
-        before = st["best"]
-        st["ref"], st["since"] = st["best"], 0
-        h = np.asarray(steps, dtype=np.float64) * (0.5 if run else 1.0)
-        zs = st["z"]
-        simplex = np.vstack([zs] + [zs + np.eye(n)[k] * h[k] for k in range(n)])
-        try:
-            with np.errstate(invalid="ignore"):  # inf − inf at refused vertices: not a stop
-                nelder_mead(f, simplex, maxfev=maxfev - st["n"], fatol=fatol, adaptive=n > 2)
-        except _Stalled:
-            pass
-        if before - st["best"] <= fatol or st["n"] >= maxfev:
-            break
-    return st["z"], st["best"] * scale, st["n"], st["n"] >= maxfev
 
 
 def _free_coords(model, fixed, C):
@@ -445,9 +398,13 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
     if procedure != "direct":
         cand = [(p.name, min(1.0, p.upper)) for p in model.params
                 if p.kind == "colour" and any(c.name == p.name for c in coords)]
-        cand = [c for c in cand if sp.is_affine(values, [c], rng)]
-        if len(cand) == 1 or (cand and sp.is_affine(values, cand, rng)):
+        # jointly first (affine jointly implies affine in each alone): one test, not K + 1
+        if len(cand) > 1 and sp.is_affine(values, cand, rng):
             linear = cand
+        else:
+            cand = [c for c in cand if sp.is_affine(values, [c], rng)]
+            if len(cand) == 1 or (cand and sp.is_affine(values, cand, rng)):
+                linear = cand
     lin_names = [n for n, _ in linear]
     record["linear"] = lin_names
     decl = {p.name: p for p in model.params}
@@ -490,7 +447,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         def obj(z):
             v = from_vector(z, free, v0)
             return projected(p, v) if projecting else p.loss_at(v)
-        z, val, nfev, limit = _nelder_mead(obj, as_vector(v0, free), steps, budget, scale,
+        z, val, nfev, limit = search_simplex(obj, as_vector(v0, free), steps, budget, scale,
                                            fatol)
         end = from_vector(z, free, v0)
         if projecting:
@@ -560,7 +517,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
             # root's optimum was rejected above)
             n0 = n_evals()
             before = prob.loss_at(values)
-            z, val, _, limit = _nelder_mead(
+            z, val, _, limit = search_simplex(
                 lambda z: prob.loss_at(from_vector(z, coords, values)), as_vector(values, coords),
                 np.array([c.step(_val(values, c)) for c in coords]),
                 max(max_evals, 60 * len(coords)), scale, FRTOL)
@@ -604,16 +561,31 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
                 sp, from_vector(np.full(len(opt), zz), opt, start)))
             starts.append(("nested: without " + ", ".join(nested),
                            from_vector(np.full(len(opt), best_z), opt, start)))
+        # a parameter whose bounds are sub-models (BRDF.fit_bound_starts: Nielsen's α, 0
+        # Phong, 1 Blinn–Phong) is started near each bound, always (not skipped by
+        # consensus), in place of the defaults and random starts: a run from the middle can
+        # settle in one end's basin while the other end fits better (20 of 100 MERL
+        # materials), and the defaults are one arbitrary point where these are two
+        # structured ones
+        always = []
+        for c in shape:
+            if c.name in model.fit_bound_starts and c.transform == "logit":
+                always += [(f"{c.label} near its {side} bound", from_vector([z], [c], values))
+                           for side, z in (("lower", -BOUND_START_Z), ("upper", BOUND_START_Z))]
+        starts += always
         if n_starts >= 2:
             starts.append(("defaults", defaults))
         z_guess = as_vector(values, shape)
         for k in range(n_starts - 2):
             starts.append((f"random {k + 1}", from_vector(
                 z_guess + rng.normal(0.0, 1.0, len(shape)), shape, values)))
+        starts = starts[:(max(n_starts, 1 + len(always)) if n_starts > 1 else 1)
+                        + bool(nested)]
+        always = {label for label, _ in always}
         best = None
         agree = 0
-        for label, v0 in starts[:n_starts + bool(nested)]:
-            if agree >= 1:
+        for label, v0 in starts:
+            if agree >= 1 and label not in always:
                 # two runs from different starts reached the same loss (within CONSENSUS):
                 # the remaining starts are recorded as skipped
                 record["starts"].append({"start": label, "skipped": "consensus"})
@@ -621,8 +593,19 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
             if linear and procedure == "nielsen":
                 # Nielsen's (ii): the linear parameters solved at the start, then held
                 v0 = solve_at(sp, v0) or v0
-            end, val, nfev, limit = search(sp, shape, v0, linear and procedure != "nielsen",
-                                           budget, steps, FRTOL)
+            end, val, nfev, limit = search(
+                sp, shape, v0, linear and procedure != "nielsen", budget,
+                # near a bound the logit's steps at the guess would hardly move it
+                np.array([c.step(_val(v0, c)) for c in shape]) if label in always else steps,
+                FRTOL)
+            if linear and procedure == "nielsen":
+                # runs compared with their linear parameters re-solved, as stage (iii) will
+                # have them: by the loss with them held at the start's solution, a run that
+                # ended where those values happened to fit won (green-fabric: η < 1, 2x the
+                # loss of the best shape)
+                solved = solve_at(sp, end, want_loss=True)
+                if solved[0] is not None:
+                    end, val = solved
             record["starts"].append({"start": label, "from": _jsonable(v0, coords),
                                      "to": _jsonable(end, coords), "loss": val,
                                      "evaluations": nfev, "hit_limit": bool(limit)})
@@ -650,8 +633,13 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         free3 = coords
     # variable projection is exact for l1, l2, ngan: min over (shape, linear) of the loss
     # is min over the shape of the loss with the linear parameters solved, so the staged
-    # procedure's joint stage (iii) is the shape polished with them re-solved
-    projected3 = bool(procedure == "staged" and linear and shape and loss in EXACT_PROJECTION)
+    # procedure's joint stage (iii) is the shape polished with them re-solved. Nielsen's
+    # (iii) frees (s, α, η, k_s): the same, with ρ_d re-solved too (free in closed form).
+    # Solved by a simplex over k_s and η per channel, it reached its budget on 80 of 600
+    # study fits; with ρ_d held from stage (ii), the result depended on that path (the
+    # α-mix ended 1.5 % worse than Blinn-Phong on green-fabric at the same s, α)
+    projected3 = bool(procedure in ("staged", "nielsen") and linear and shape
+                      and loss in EXACT_PROJECTION)
     if projected3:
         free3 = shape
     if free3:
@@ -669,8 +657,8 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         # the final stage's stop decides: a stage-(ii) search cut by its budget and then
         # polished here to the tolerance is a converged result (its limit stays recorded)
         hit_limit = limit
-        stage_record("iii: " + ("shape and shape-dependent linear" if procedure == "nielsen"
-                                else "shape, linear re-solved (= all jointly)" if projected3
+        stage_record("iii: " + ("shape, linear re-solved (= all jointly)" if projected3
+                                else "shape and shape-dependent linear" if procedure == "nielsen"
                                 else "all"), [c.label for c in free3], n0, before,
                      min(val, before), limit, values)
     # linear parameters solved exactly in a box (variable projection to the end) sit at a

@@ -280,6 +280,10 @@ class BRDF:
     #: first lobe: (C_xy, C_z) → t·(C_xy, C_z) with ρ_s → ρ_s / tⁿ). Fitted, they make the
     #: loss exactly flat along a curve and the optimiser crawl along it to its budget.
     fit_gauge: ClassVar[tuple[str, ...]] = ()
+    #: Bounded shape parameters whose bounds are sub-models (e.g. Nielsen's α: 0 Phong-like,
+    #: 1 Blinn-like): a fit also starts its search near each bound, so that it does not
+    #: settle in one end's basin when the other end fits better.
+    fit_bound_starts: ClassVar[tuple[str, ...]] = ()
     #: Compiled loop specialised to ``kernel`` (:func:`checked_driver`), or None for the
     #: generic :func:`eval_pairs_checked` (a composite kernel, e.g. pumped, sets one).
     _driver: Callable | None = None

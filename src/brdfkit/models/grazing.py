@@ -210,6 +210,7 @@ class Nielsen(CosineLobeBRDF):
               lower_open=True, optional=True),
     )
     citation = "Nielsen et al. eq. (3), Fresnel factor as in the text"
+    fit_bound_starts = ("alpha",)  # α = 0: the Phong-like lobe, α = 1: the Blinn-like one
     reciprocal = True
     width_param = "s"
     kernel = _nielsen
