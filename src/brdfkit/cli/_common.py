@@ -80,7 +80,8 @@ def _parse_number(text: str, name: str, model: str, bounds: str) -> float:
         ) from None
 
 
-def parse_param_items(model_name: str, items: Iterable[str] | Mapping) -> dict:
+def parse_param_items(model_name: str, items: Iterable[str] | Mapping, *,
+                      option: str = "-p") -> dict:
     """Convert ``NAME=VALUE`` strings to keyword arguments for model *model_name*.
 
     Parameters
@@ -91,6 +92,9 @@ def parse_param_items(model_name: str, items: Iterable[str] | Mapping) -> dict:
     items : iterable of str, or mapping
         ``NAME=VALUE`` strings as typed on the command line. A mapping is
         taken as already parsed and returned as a dict (no unit conversion).
+    option : str
+        The command-line option the items came from, named in the error for a
+        malformed item (``-p``, ``--start``).
 
     Returns
     -------
@@ -114,7 +118,7 @@ def parse_param_items(model_name: str, items: Iterable[str] | Mapping) -> dict:
         name, text = name.strip(), text.strip()
         if not sep or not name or not text:
             raise ParameterError(
-                f"parameter must be given as NAME=VALUE (e.g. -p rho_d=0.5); got {item!r}"
+                f"parameter must be given as NAME=VALUE (e.g. {option} rho_d=0.5); got {item!r}"
             )
         if name in out:
             raise ParameterError(f"{label}: parameter {name!r} given twice")

@@ -93,7 +93,7 @@ def fit_cmd(models, param, start, pump, times, to, loss, procedure, seed, starts
 
         check_output_path(plot, option="--plot")  # fail before the fit, not after
     given = parse_param_items(model, param)
-    both = sorted(set(given) & set(parse_param_items(model, start)))
+    both = sorted(set(given) & set(parse_param_items(model, start, option="--start")))
     if both:
         raise BrdfkitError(f"{', '.join(both)}: given with both -p (held) and --start (fitted); "
                            "use one")
@@ -148,7 +148,7 @@ def _batch(models, targets, *, param, start, pump, times, loss, procedure, seed,
         canonical_name(m)  # an unknown model fails now, not in every row
     starts = {}
     for m in models if start else ():  # starting values; every model must take them
-        starts = parse_param_items(m, start)
+        starts = parse_param_items(m, start, option="--start")
         if "beta" in starts:
             raise BrdfkitError("--start beta=...: a batch takes the models' own parameter "
                                "names (the width parameter, not beta)")
