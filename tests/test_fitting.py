@@ -158,6 +158,9 @@ def test_fit_command_start_frees_an_optional_parameter(tmp_path):
     # the same name held and started: one line, exit 2
     res = run("fit", "nielsen", "--to", str(path), "--start", "eta=1.5", "-p", "eta=2")
     assert res.exit_code == 2 and "both -p (held) and --start (fitted)" in res.output
+    # a malformed --start item: the error names --start, not -p
+    res = run("fit", "nielsen", "--to", str(path), "--start", "eta")
+    assert res.exit_code == 2 and "(e.g. --start rho_d=0.5); got 'eta'" in res.output
 
 
 @pytest.mark.parametrize("adaptive", [False, True])
