@@ -327,7 +327,7 @@ def _neumann_figure(study, path):
     targets = sorted(set().union(*[set(r) for _, r in series]))
     if not targets:
         return None
-    fig, axes = plt.subplots(1, 2, figsize=(10.0, 3.6), sharey=True, layout="constrained")
+    fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.2), sharey=True, layout="constrained")
     width = 0.8 / len(series)
     x = np.arange(len(targets))
     for ax, key, title in ((axes[0], "e_point", "point light: max |ln(f̂ cos / f cos)|"),
@@ -341,7 +341,9 @@ def _neumann_figure(study, path):
         ax.set_title(title, fontsize=9)
         ax.set_yscale("log")
     axes[0].set_ylabel("maximal log ratio (relative error ≈ e^x − 1)")
-    axes[1].legend(fontsize=7, frameon=False)
+    # below the panels: inside, the legend covered the bars of the first materials
+    fig.legend(*axes[1].get_legend_handles_labels(), fontsize=7, frameon=False, ncols=3,
+               loc="outside lower center")
     fig.suptitle("Neumann §1.1 on the metals: perceptual vs L2 fits", fontsize=10)
     return _save(fig, path)
 
