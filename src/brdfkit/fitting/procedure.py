@@ -80,15 +80,17 @@ channel is held at the root's value (``convergence["scale_held"]``;
 :mod:`brdfkit.fitting._pumped`).
 
 Stopping and status: a Nelder–Mead run stops when its vertices' losses agree
-to :data:`FRTOL` of the loss after stage (i), or after :data:`~brdfkit.fitting._simplex.STALL_EVALS`
-evaluations per coordinate without such an improvement (a flat valley, or a
-bound approached asymptotically in z); its stop is checked by one restart
-from the best point. The status is set by the last stage: MAX_EVALS when it
+to :data:`FRTOL` of the loss after stage (i), or after
+:data:`~brdfkit.fitting._simplex.STALL_EVALS` evaluations per coordinate without
+such an improvement (a flat valley, or a bound approached asymptotically in z);
+its stop is checked by one restart from the best point. The status is set by the last stage: MAX_EVALS when it
 reached its budget (a stage-(ii) search cut by its budget and then polished
 to the tolerance is recorded but converged). A polish cut by its budget is
 run once more (stage "iii'") with the coordinates at (or indistinguishable
 from) a bound set there and held: it converges where the crawl was towards a
-bound approached only asymptotically in z. Bounds are checked after the
+bound approached only asymptotically in z; with none at a bound, once more with
+the search's (ten times larger) steps, which travels along a long valley where
+the polish's small simplex crawled. Bounds are checked after the
 last stage: a coordinate at a bound, or one the loss cannot tell from a bound
 (moved there the loss rises by less than :data:`BOUND_LOSS_RTOL` relative;
 the bound is taken if the loss falls), is reported (``at_bounds``, status
