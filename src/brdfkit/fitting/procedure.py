@@ -29,8 +29,8 @@ Stages of ``procedure="staged"`` (= ``"auto"``, any model):
 (i) first guess and linear parameters: the width parameter (the model's
     ``width_param``) from the measured peak's half-width β (via
     ``width_from_beta``) and from the ladder β = 0.5°, 1°, …, 64°
-    (:data:`BETA_LADDER_DEG`), each with the linear parameters solved; the
-    width of least loss is kept (a measured peak alone can mislead: the clear
+    (:data:`~brdfkit.fitting._guess.BETA_LADDER_DEG`), each with the linear
+    parameters solved; the width of least loss is kept (a measured peak alone can mislead: the clear
     coat of two-layer-silver gives β → 0, s ≈ 10⁶, a local optimum on the
     spike far from the broad lobe); the linear parameters solved there.
 (ii) search over the shape parameters on a coarser grid
@@ -43,7 +43,9 @@ Stages of ``procedure="staged"`` (= ``"auto"``, any model):
     reflection) — so a free optional parameter never makes the fit worse;
     for a parameter whose bounds are sub-models (``BRDF.fit_bound_starts``:
     Nielsen's α, 0 Phong-like, 1 Blinn-like) two starts near its bounds
-    (:data:`BOUND_START_Z`), which always run; the declared defaults (an
+    (:data:`BOUND_START_Z`), which always run — under ``procedure="nielsen"``
+    the two sub-models at the bounds fitted first instead, their optima taken
+    as they are, so that the α-mix is never worse than either end; the declared defaults (an
     optional parameter declared None keeps its value); ``n_starts − 2``
     random ones (z of the guess plus N(0, 1), from
     ``numpy.random.default_rng(seed)``) — ``n_starts`` starts in all besides the
@@ -83,19 +85,20 @@ Stopping and status: a Nelder–Mead run stops when its vertices' losses agree
 to :data:`FRTOL` of the loss after stage (i), or after
 :data:`~brdfkit.fitting._simplex.STALL_EVALS` evaluations per coordinate without
 such an improvement (a flat valley, or a bound approached asymptotically in z);
-its stop is checked by one restart from the best point. The status is set by the last stage: MAX_EVALS when it
-reached its budget (a stage-(ii) search cut by its budget and then polished
-to the tolerance is recorded but converged). A polish cut by its budget is
-run once more (stage "iii'") with the coordinates at (or indistinguishable
-from) a bound set there and held: it converges where the crawl was towards a
-bound approached only asymptotically in z; with none at a bound, once more with
-the search's (ten times larger) steps, which travels along a long valley where
-the polish's small simplex crawled. Bounds are checked after the
-last stage: a coordinate at a bound, or one the loss cannot tell from a bound
-(moved there the loss rises by less than :data:`BOUND_LOSS_RTOL` relative;
-the bound is taken if the loss falls), is reported (``at_bounds``, status
-AT_BOUND, named in the message) — never a plain "converged". Every stage
-record lists the coordinates at a bound after it.
+its stop is checked by one restart from the best point. The status is set by
+the last stage: MAX_EVALS when it reached its budget (a stage-(ii) search cut
+by its budget and then polished to the tolerance is recorded but converged).
+A polish cut by its budget is run once more (stage "iii'") with the
+coordinates at (or indistinguishable from) a bound set there and held: it
+converges where the crawl was towards a bound approached only asymptotically
+in z; with none at a bound, once more with the search's (ten times larger)
+steps, which travels along a long valley where the polish's small simplex
+crawled. Bounds are checked after the last stage: a coordinate at a bound, or
+one the loss cannot tell from a bound (moved there the loss rises by less than
+:data:`BOUND_LOSS_RTOL` relative; the bound is taken if the loss falls), is
+reported (``at_bounds``, status AT_BOUND, named in the message) — never a
+plain "converged". Every stage record lists the coordinates at a bound after
+it.
 
 The fit evaluates on one thread (``numba.set_num_threads(1)``, restored
 after): for ~15,000 pairs the parallel driver's thread wake-ups cost more
@@ -112,6 +115,7 @@ import numba
 import numpy as np
 
 from brdfkit.errors import BrdfkitError, ParameterError
+from brdfkit.fitting import _guess
 from brdfkit.fitting._problem import IRLS_ITERATIONS, Problem
 from brdfkit.fitting._pumped import hold_scale
 from brdfkit.fitting._simplex import search_simplex
@@ -162,9 +166,6 @@ _polish = lambda max_evals, free: max(max_evals, 100 * len(free), POLISH_MIN_EVA
 #: of 8,134; stage (iii) polishes on the fit's own samples. The time per evaluation is then
 #: mostly fixed costs (model set-up, linear solves), so coarser cells gain little.
 SEARCH_STRIDES = (9, 45)
-#: Half-widths (degrees) scanned for the first guess of the width parameter (with the
-#: measured one): mirror-like to broad, a factor 2 apart.
-BETA_LADDER_DEG = (0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0)
 #: z of the optional parameters (e.g. η) tried at the nested model's optimum: the one
 #: where the loss is least (where the parameter changes the model least) starts stage (ii).
 NEUTRAL_Z = (-Z_MAX, -6.0, -2.0, 0.0, 2.0, 6.0, Z_MAX)
@@ -234,28 +235,6 @@ class FitResult:
 
 
 # --------------------------------------------------------------------------- helpers
-def _measured_half_width(target) -> float:
-    """Half-width (rad, in θ_h) of the target's specular peak: the profile of f·cos θ_i
-    along θ_h at θ_d = 5°, φ_d = 90°, minus its floor, falls to half its value at θ_h → 0
-    (the first bin centre). π/4 when there is no peak (a diffuse target)."""
-    from brdfkit.data.merl import half_diff_to_directions
-
-    u = (np.arange(90) + 0.5) / 90.0
-    th = u * u * (0.5 * math.pi)
-    wi, wo = half_diff_to_directions(th, np.full_like(th, math.radians(5.0)),
-                                     np.full_like(th, 0.5 * math.pi))
-    wi /= np.linalg.norm(wi, axis=1, keepdims=True)
-    wo /= np.linalg.norm(wo, axis=1, keepdims=True)
-    f = np.asarray(target.eval(wi, wo)).reshape(90, -1).mean(axis=1)
-    f = np.nan_to_num(f, nan=0.0)
-    floor = float(np.min(f))
-    peak = float(f[0]) - floor
-    if not peak > 0.0:
-        return math.pi / 4
-    below = np.nonzero(f - floor < 0.5 * peak)[0]
-    return float(th[below[0]]) if below.size else math.pi / 4
-
-
 def _free_coords(model, fixed, C):
     """(coords of every free scalar, names held, the values to start from)."""
     values = model.values
@@ -377,14 +356,14 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
 
     # data-driven first guess: the lobe width from the measured peak (refined below by a
     # scan of widths once the linear parameters are known)
-    beta = _measured_half_width(target)
+    beta = _guess.measured_half_width(target)
     record["measured_half_width_deg"] = math.degrees(beta)
     wp = model.width_param
     scan_width = wp is not None and wp not in fixed and any(c.name == wp for c in coords)
     # a pumped model's width parameter is its root's (the lobe keeps its shape)
     width_from_beta = (model.root if isinstance(model, PumpedBRDF) else model).width_from_beta
     if scan_width:
-        values = _with_width(values, wp, width_from_beta, beta)
+        values = _guess.with_width(values, wp, width_from_beta, beta)
 
     # parameters that change nothing are held (and reported); tested on the search's
     # samples (every θ_h bin), as the linearity below: properties of the model, not of
@@ -475,7 +454,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         n0 = n_evals()
         before = prob.loss_at(values)
         if scan_width:  # the width whose projected loss is least (module docstring)
-            values, record["width_scan"] = _scan_width(
+            values, record["width_scan"] = _guess.scan_width(
                 values, wp, width_from_beta, beta, lambda v: projected(sp, v))
         solved = solve_at(prob, values)
         if solved is not None:
@@ -569,11 +548,32 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         # settle in one end's basin while the other end fits better (20 of 100 MERL
         # materials), and the defaults are one arbitrary point where these are two
         # structured ones
-        always = []
+        # Under procedure="nielsen" (the paper compares the α-mix with its two ends) each
+        # end is fitted first instead, and its optimum, the parameter at the bound, is a
+        # candidate as it is (no search from it): the mix is then never worse than either
+        # end (it was on 6 of 100 materials with the starts near the bounds alone)
+        always, prefit = [], set()
         for c in shape:
-            if c.name in model.fit_bound_starts and c.transform == "logit":
-                always += [(f"{c.label} near its {side} bound", from_vector([z], [c], values))
-                           for side, z in (("lower", -BOUND_START_Z), ("upper", BOUND_START_Z))]
+            if c.name not in model.fit_bound_starts or c.transform != "logit":
+                continue
+            for side, z in (("lower", -BOUND_START_Z), ("upper", BOUND_START_Z)):
+                if procedure != "nielsen" or c.index is not None:
+                    always.append((f"{c.label} near its {side} bound",
+                                   from_vector([z], [c], values)))
+                    continue
+                x = c.lower if side == "lower" else c.upper
+                end_fit = _fit(model.with_params(**{c.name: x}), target, loss, procedure,
+                               {**fixed, c.name: x}, theta_max, seed, n_starts, strides,
+                               max_evals)
+                label = f"{c.label} = {x:g} fitted first"
+                record.setdefault("bound_fits", {})[label] = {
+                    "value": end_fit.value, "status": end_fit.status,
+                    "evaluations": end_fit.convergence["evaluations"]}
+                start = {**values, **{k: (np.asarray(v, dtype=np.float64)
+                                          if isinstance(v, list) else v)
+                                      for k, v in end_fit.params.items()}}
+                always.append((label, from_vector([np.sign(z) * Z_MAX], [c], start)))
+                prefit.add(label)
         starts += always
         if n_starts >= 2:
             starts.append(("defaults", defaults))
@@ -592,14 +592,17 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
                 # the remaining starts are recorded as skipped
                 record["starts"].append({"start": label, "skipped": "consensus"})
                 continue
-            if linear and procedure == "nielsen":
-                # Nielsen's (ii): the linear parameters solved at the start, then held
-                v0 = solve_at(sp, v0) or v0
-            end, val, nfev, limit = search(
-                sp, shape, v0, linear and procedure != "nielsen", budget,
-                # near a bound the logit's steps at the guess would hardly move it
-                np.array([c.step(_val(v0, c)) for c in shape]) if label in always else steps,
-                FRTOL)
+            if label in prefit:  # an end fitted first: its optimum as it is
+                end, val, nfev, limit = v0, math.nan, 0, False
+            else:
+                if linear and procedure == "nielsen":
+                    # Nielsen's (ii): the linear parameters solved at the start, then held
+                    v0 = solve_at(sp, v0) or v0
+                end, val, nfev, limit = search(
+                    sp, shape, v0, linear and procedure != "nielsen", budget,
+                    # near a bound the logit's steps at the guess would hardly move it
+                    np.array([c.step(_val(v0, c)) for c in shape]) if label in always
+                    else steps, FRTOL)
             # the runs are compared on the fit's own samples with the linear parameters
             # re-solved, as stage (iii) will have them. On the search's grid a sharp lobe
             # can look better than it is (black-obsidian, Nielsen with η: α ≈ 0, s ≈ 2900
@@ -608,7 +611,10 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
             # a run that ended where those happened to fit won (green-fabric: η < 1, twice
             # the loss of the best shape)
             val_search = val
-            solved = solve_at(prob, end, want_loss=True) if linear else (end, prob.loss_at(end))
+            # (the L1 solve to convergence: warm-started from the previous run's shape, the
+            # search's three IRLS steps left an end fitted first at 0.0107 for its 0.00907)
+            solved = (solve_at(prob, end, want_loss=True, iterations=IRLS_FINAL) if linear
+                      else (end, prob.loss_at(end)))
             if solved[0] is not None:
                 end, val = solved
             record["starts"].append({"start": label, "from": _jsonable(v0, coords),
@@ -710,29 +716,6 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
                                "table_time_s": fast.table_time_s}
         prob.model = model  # the result: the exact pumped model
     return _result(prob, target, values, coords, record, hit_limit, t_start, flat, n_evals())
-
-
-def _with_width(values, wp, width_from_beta, beta):
-    """*values* with the width parameter set from half-width *beta* (radians)."""
-    # β clamped to (0, π/2) open, as width_from_beta requires: 1e-4 rad is a mirror-like
-    # lobe, 1.4 rad (80°) a broad one
-    w0 = float(width_from_beta(min(max(beta, 1e-4), 1.4)))
-    out = dict(values)
-    out[wp] = np.full(np.shape(values[wp]), w0) if np.ndim(values[wp]) else w0
-    return out
-
-
-def _scan_width(values, wp, width_from_beta, beta, loss_of):
-    """The first guess of the width: the measured half-width *beta* and the ladder
-    :data:`BETA_LADDER_DEG`, each with the linear parameters solved (*loss_of*); the one of
-    least loss. A measured peak can mislead (two-layer-silver: a mirror-like spike of its
-    clear coat on a broad lobe gives s ≈ 10⁶, a local optimum far from the broad lobe)."""
-    tried = []
-    for b in (beta, *np.radians(BETA_LADDER_DEG)):
-        v = _with_width(values, wp, width_from_beta, float(b))
-        tried.append((loss_of(v), math.degrees(float(b)), v))
-    best = min(tried, key=lambda t: t[0])
-    return best[2], [{"beta_deg": b, "loss": val} for val, b, _ in tried]
 
 
 def _flat_to_bound(prob, values, coords):
