@@ -449,6 +449,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
             progress(name, n_evals(), after)
 
     hit_limit = False
+    best = None  # stage (ii)'s best run: (loss, values, hit_limit, start label)
     # ---------------------------------------------------------------- stage (i)
     if linear:
         n0 = n_evals()
@@ -552,7 +553,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         # end is fitted first instead, and its optimum, the parameter at the bound, is a
         # candidate as it is (no search from it): the mix is then never worse than either
         # end (it was on 6 of 100 materials with the starts near the bounds alone)
-        always, prefit = [], set()
+        always, prefit = [], {}
         for c in shape:
             if c.name not in model.fit_bound_starts or c.transform != "logit":
                 continue
@@ -573,7 +574,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
                                           if isinstance(v, list) else v)
                                       for k, v in end_fit.params.items()}}
                 always.append((label, from_vector([np.sign(z) * Z_MAX], [c], start)))
-                prefit.add(label)
+                prefit[label] = (c, np.sign(z) * BOUND_START_Z)
         starts += always
         if n_starts >= 2:
             starts.append(("defaults", defaults))
@@ -624,7 +625,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
             if best is not None and abs(val - best[0]) <= CONSENSUS * abs(best[0]):
                 agree += 1
             if best is None or val < best[0]:
-                best = (val, end, limit)
+                best = (val, end, limit, label)
         values = best[1]
         hit_limit = best[2]  # superseded by stage (iii)'s: the last stage decides the status
         after = prob.loss_at(values)
@@ -657,9 +658,16 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
     if free3:
         n0 = n_evals()
         before = prob.loss_at(values)
+        start3 = values
+        if best is not None and best[3] in prefit and any(c is prefit[best[3]][0] for c in free3):
+            # an end fitted first won: the polish starts just inside its bound, where the
+            # parameter can move (at the bound's z it cannot: the mix would stay the end);
+            # its result is kept only if better than the end (val <= before below)
+            c_end, z_end = prefit[best[3]]
+            start3 = from_vector([z_end], [c_end], values)
         # a tenth of stage (ii)'s steps: stage (iii) starts near a stationary point
-        steps = 0.1 * np.array([c.step(_val(values, c)) for c in free3])
-        end, val, _, limit = search(prob, free3, values, projected3,
+        steps = 0.1 * np.array([c.step(_val(start3, c)) for c in free3])
+        end, val, _, limit = search(prob, free3, start3, projected3,
                                     _polish(max_evals, free3), steps, FRTOL_POLISH)
         if projected3:  # the final linear solve to convergence (IRLS_FINAL steps for l1)
             end = solve_at(prob, end, iterations=IRLS_FINAL) or end
