@@ -200,9 +200,8 @@ def test_solve_channels_matches_the_single_channel_solve_and_its_loss(K):
     R = np.einsum("knc,k->nc", B, rng.random(K)) + 0.05 * rng.standard_normal((N, C))
     w = rng.random(N) + 0.1
     lo, hi = np.zeros(K), np.full(K, 10.0)
-    LO, HI = np.zeros((K, C)), np.full((K, C), 10.0)
     for l1 in (False, True):
-        P, total = solve_channels(B, R, w, LO, HI, l1, 20, np.empty((0, 0)))
+        P, total = solve_channels(B, R, w, lo, hi, l1, 20, np.empty((0, 0)))
         ref = np.stack([solve_channel(np.ascontiguousarray(B[:, :, c].T),
                                       np.ascontiguousarray(R[:, c]), w, lo, hi, l1, 20,
                                       np.empty(0)) for c in range(C)], axis=1)
@@ -211,4 +210,4 @@ def test_solve_channels_matches_the_single_channel_solve_and_its_loss(K):
         assert total == pytest.approx(float(np.sum(w[:, None] * (np.abs(d) if l1 else d * d))),
                                       rel=1e-12)
     B[0, 3, 1] = np.nan  # a non-finite basis value: the loss is inf, not NaN
-    assert solve_channels(B, R, w, LO, HI, True, 3, np.empty((0, 0)))[1] == math.inf
+    assert solve_channels(B, R, w, lo, hi, True, 3, np.empty((0, 0)))[1] == math.inf

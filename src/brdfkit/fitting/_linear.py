@@ -267,11 +267,11 @@ def _residual_sum(A, r, w, p, l1):  # pragma: no cover - compiled
 def solve_channels(B, R, w, lo, hi, l1, iterations, P_start):  # pragma: no cover - compiled
     """:func:`solve_channel` for every channel at once, and the loss at the solution.
 
-    *B* (K, N, C): the bases; *R* (N, C): the target minus the offset; *lo*, *hi*
-    (K, C): the bounds per channel (lo = hi holds a parameter); *P_start* (K, C) or
-    empty. Returns (P (K, C), Σ_c Σ_j w_j |residual| (l1) or residual² (l2)),
-    the sum inf when a residual is not finite. One call instead of one per channel and
-    a loss assembled in NumPy: the fixed cost per evaluation of a fit's search.
+    *B* (K, N, C): the bases; *R* (N, C): the target minus the offset; *lo*, *hi* (K,):
+    the bounds; *P_start* (K, C) or empty. Returns (P (K, C), Σ_c Σ_j w_j |residual|
+    (l1) or residual² (l2)), the sum inf when a residual is not finite. One call instead
+    of one per channel and a loss assembled in NumPy: the fixed cost per evaluation of a
+    fit's search.
     """
     K, N, C = B.shape
     P = np.empty((K, C))
@@ -292,8 +292,7 @@ def solve_channels(B, R, w, lo, hi, l1, iterations, P_start):  # pragma: no cove
                 for j in range(N):
                     A[j, k] = B[k, j, c]
         start = P_start[:, c].copy() if P_start.size == K * C else np.empty(0)
-        p = _solve(A, At, r, w, np.ascontiguousarray(lo[:, c]), np.ascontiguousarray(hi[:, c]),
-                   l1, iterations, start)
+        p = _solve(A, At, r, w, lo, hi, l1, iterations, start)
         P[:, c] = p
         if small:
             q = np.zeros(3)

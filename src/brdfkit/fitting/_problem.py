@@ -71,7 +71,6 @@ class Problem:
             self.samples = s = s.subset(ok)
             self.w, self.cos, y = s.weight, s.cos_i[:, None], y[ok]
         self.y = y * self.cos
-        self._w_sum = float(np.sum(self.w))
         self.ngan_mask = ((s.wi[:, 2] >= math.cos(math.radians(NGAN_THETA_MAX_DEG)))
                           & (s.wo[:, 2] >= math.cos(math.radians(NGAN_THETA_MAX_DEG))))
         # the weights of the linear solve: Ngan's metric is over θ_i, θ_o ≤ 80° only, so its
@@ -79,6 +78,7 @@ class Problem:
         # fits of red-plastic ended at L 0.0104 where their own shape's optimum is 0.0087)
         self.w_solve = (np.ascontiguousarray(self.w * self.ngan_mask) if loss == "ngan"
                         else self.w)
+        self._w_solve_sum = float(np.sum(self.w_solve))
         self.albedo_t = None
         if loss == "perceptual":
             self._perceptual_albedo(target)
@@ -209,13 +209,10 @@ class Problem:
     def solve_linear(self, f0, B, lo, hi, loss: str, *,
                      iterations: int = IRLS_ITERATIONS) -> tuple[np.ndarray, float | None]:
         """Per-channel linear parameters P (K, C) minimising the L1 (``l1``, at most
-        *iterations* IRLS steps) or L2 (other losses) norm, and the loss at P for ``l1``
-        and ``l2`` (None for the other losses: their value needs the prediction)
+        *iterations* IRLS steps) or L2 (other losses) norm, and the loss at P for ``l1``,
+        ``l2`` and ``ngan`` (None for the others: their value needs the prediction)
         (:func:`brdfkit.fitting._linear.solve_channels`)."""
         K = len(B)
-        # bounds per parameter (K,) or per parameter and channel (K, C)
-        lo = np.ascontiguousarray(np.broadcast_to(np.reshape(lo, (K, -1)), (K, self.C)))
-        hi = np.ascontiguousarray(np.broadcast_to(np.reshape(hi, (K, -1)), (K, self.C)))
         start = (self._warm if self._warm is not None and self._warm.shape == (K, self.C)
                  else np.empty((0, 0)))
         if f0 is self.static.get(""):  # a shape-independent offset: y − f₀ once
@@ -227,11 +224,9 @@ class Problem:
         P, total = solve_channels(np.stack(B), R, self.w_solve, lo, hi, loss == "l1", iterations,
                                   start)
         self._warm = P.copy()
-        # the normalisation of losses.loss_value: Σ w |d| / (Σ w · C)
-        if loss in ("l1", "l2"):
-            value = total / (self._w_sum * self.C)
-        elif loss == "ngan":  # √(Σ_masked w d² / (Σ_masked w · C)), as losses.loss_value
-            value = math.sqrt(total / (float(np.sum(self.w_solve)) * self.C))
-        else:
-            value = None
-        return P, value
+        # the normalisation of losses.loss_value: Σ w |d| / (Σ w · C), for ngan over its
+        # samples (w_solve) and its square root
+        if loss not in ("l1", "l2", "ngan"):
+            return P, None
+        value = total / (self._w_solve_sum * self.C)
+        return P, (math.sqrt(value) if loss == "ngan" else value)

@@ -479,8 +479,7 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
                                                   if k in model.root.values}),
                         target, loss, procedure, fixed, theta_max, seed, n_starts, strides,
                         max_evals)
-        start = {**values, **{k: (np.asarray(v, dtype=np.float64) if isinstance(v, list)
-                                  else v) for k, v in root_fit.params.items()}}
+        start = {**values, **root_fit.model.values}
         after = prob.loss_at(start)
         if after <= before:
             values = start
@@ -535,9 +534,8 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
             record["nested"] = {"without": nested, "value": inner.value,
                                 "status": inner.status, "params": inner.params,
                                 "evaluations": inner.convergence["evaluations"]}
-            start = {**values, **{k: (np.asarray(v, dtype=np.float64)
-                                      if isinstance(v, list) else v)
-                                  for k, v in inner.params.items() if k not in nested}}
+            start = {**values, **{k: v for k, v in inner.model.values.items()
+                                  if k not in nested}}
             opt = [c for c in shape if c.name in nested]
             best_z = min(NEUTRAL_Z, key=lambda zz: projected(
                 sp, from_vector(np.full(len(opt), zz), opt, start)))
@@ -553,14 +551,14 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
         # end is fitted first instead, and its optimum, the parameter at the bound, is a
         # candidate as it is (no search from it): the mix is then never worse than either
         # end (it was on 6 of 100 materials with the starts near the bounds alone)
-        always, prefit = [], {}
+        bound_starts, prefit = [], {}
         for c in shape:
             if c.name not in model.fit_bound_starts or c.transform != "logit":
                 continue
             for side, z in (("lower", -BOUND_START_Z), ("upper", BOUND_START_Z)):
                 if procedure != "nielsen" or c.index is not None:
-                    always.append((f"{c.label} near its {side} bound",
-                                   from_vector([z], [c], values)))
+                    bound_starts.append((f"{c.label} near its {side} bound",
+                                         from_vector([z], [c], values)))
                     continue
                 x = c.lower if side == "lower" else c.upper
                 end_fit = _fit(model.with_params(**{c.name: x}), target, loss, procedure,
@@ -570,21 +568,19 @@ def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strid
                 record.setdefault("bound_fits", {})[label] = {
                     "value": end_fit.value, "status": end_fit.status,
                     "evaluations": end_fit.convergence["evaluations"]}
-                start = {**values, **{k: (np.asarray(v, dtype=np.float64)
-                                          if isinstance(v, list) else v)
-                                      for k, v in end_fit.params.items()}}
-                always.append((label, from_vector([np.sign(z) * Z_MAX], [c], start)))
+                bound_starts.append((label, from_vector([np.sign(z) * Z_MAX], [c],
+                                                        {**values, **end_fit.model.values})))
                 prefit[label] = (c, np.sign(z) * BOUND_START_Z)
-        starts += always
+        starts += bound_starts
         if n_starts >= 2:
             starts.append(("defaults", defaults))
         z_guess = as_vector(values, shape)
         for k in range(n_starts - 2):
             starts.append((f"random {k + 1}", from_vector(
                 z_guess + rng.normal(0.0, 1.0, len(shape)), shape, values)))
-        starts = starts[:(max(n_starts, 1 + len(always)) if n_starts > 1 else 1)
+        starts = starts[:(max(n_starts, 1 + len(bound_starts)) if n_starts > 1 else 1)
                         + bool(nested)]
-        always = {label for label, _ in always}
+        always = {label for label, _ in bound_starts}  # run whatever the consensus
         best = None
         agree = 0
         for label, v0 in starts:
