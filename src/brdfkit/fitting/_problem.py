@@ -99,9 +99,11 @@ class Problem:
         return other
 
     # ------------------------------------------------------------------ evaluation
-    def _values(self, m, wi, wo) -> np.ndarray:
+    def _values(self, m, wi, wo, *, per_channel: bool = True) -> np.ndarray:
+        """f at the pairs, (N, C); (N, 1) for a model without per-channel parameters when
+        not *per_channel* (left to broadcast)."""
         f = np.asarray(m.eval(wi, wo), dtype=np.float64).reshape(wi.shape[0], -1)
-        if f.shape[1] == 1 and self.C > 1:
+        if per_channel and f.shape[1] == 1 and self.C > 1:
             f = np.repeat(f, self.C, axis=1)
         return f
 
@@ -117,13 +119,15 @@ class Problem:
                 self.n_invalid += 1
                 return None
 
-    def predict(self, values: dict):
-        """(model, f·cos θ_i at the samples (N, C)), or (None, None)."""
+    def predict(self, values: dict, *, per_channel: bool = True):
+        """(model, f·cos θ_i at the samples (N, C), or (N, 1) as :meth:`_values` says),
+        or (None, None)."""
         m = self.build(values)
         if m is None:
             return None, None
         self.n_evals += 1
-        return m, self._values(m, self.samples.wi, self.samples.wo) * self.cos
+        return m, self._values(m, self.samples.wi, self.samples.wo,
+                               per_channel=per_channel) * self.cos
 
     def loss_of(self, m, pred, loss: str | None = None) -> float:
         loss = loss or self.loss
@@ -161,14 +165,11 @@ class Problem:
             if Bk is None:
                 v = dict(zero)
                 v[name] = unit
-                m = self.build(v)
-                if m is None:
-                    return None
-                self.n_evals += 1
                 # (N, 1) for a model without per-channel parameters left: broadcast by the
                 # subtraction instead of repeated per channel first (the search's hot path)
-                fk = np.asarray(m.eval(self.samples.wi, self.samples.wo),
-                                dtype=np.float64).reshape(len(self.cos), -1) * self.cos
+                _, fk = self.predict(v, per_channel=False)
+                if fk is None:
+                    return None
                 Bk = fk - f0 if unit == 1.0 else (fk - f0) / unit
             B.append(Bk)
         return f0, B
