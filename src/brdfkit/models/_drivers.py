@@ -348,8 +348,11 @@ def _build(kernel):
         generated = importlib.util.module_from_spec(spec)
         sys.modules[name] = generated  # Numba's cache locator looks the module up by name
         spec.loader.exec_module(generated)
-    except OSError:
-        return None  # not writable: the caller keeps the uncached loop
+    except (OSError, RuntimeError):
+        # not writable, or Numba found no place for its cache ("no locator available",
+        # a RuntimeError raised by cache=True): the caller keeps the uncached loop
+        sys.modules.pop(name, None)
+        return None
     return generated.driver
 
 
