@@ -7,8 +7,10 @@ BRDFs as brdfkit models.
 
 - :mod:`brdfkit.data.merl` — the MERL ``.binary`` format read and written
   exactly, the reference reader's lookup, :class:`~brdfkit.data.merl.MeasuredBRDF`.
-- :mod:`brdfkit.data.surrogates` — compiled kernels of the compact surrogates
-  (NBRDF, NPF, ABC, SGD) and :class:`~brdfkit.data.surrogates.SurrogateBRDF`.
+- :mod:`brdfkit.data.surrogates` — compiled kernels and builders of the compact
+  surrogates (NBRDF, NPF, ABC, SGD).
+- :mod:`brdfkit.data.surrogate_model` — :class:`~brdfkit.data.surrogate_model.SurrogateBRDF`,
+  a built-in material as a model, with its citations and licences.
 - :mod:`brdfkit.data.catalog` — the 159 built-in materials (package data) and the
   material-spec dispatcher :func:`material` (``merl:NAME[@nbrdf|npf|abc|sgd]``,
   ``rgl:NAME``, ``nielsen:NAME``, a ``.binary`` path).
