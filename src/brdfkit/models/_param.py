@@ -1,0 +1,176 @@
+"""
+Declarations a model is built from: its parameters and its lobes
+================================================================
+
+A model declares its parameters once (:class:`Param`: default, bounds, unit,
+kind, doc); the command line, the fitter and the explorer read this
+declaration, and :meth:`Param.validate` is the one check of a value (errors
+name the model, the parameter, the allowed range and the value received).
+:class:`Lobe` says where a model's energy concentrates, for lobe-aware
+numerics. Both are re-exported by :mod:`brdfkit.models._base` and
+:mod:`brdfkit.models`.
+
+Public objects
+--------------
+- :class:`Param` — a declared parameter and its validation.
+- :class:`Lobe` — a lobe's kind and angular half-width.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from brdfkit.errors import ParameterError
+
+__all__ = ["Lobe", "Param"]
+
+
+@dataclass(frozen=True)
+class Lobe:
+    """Where a model's reflected energy concentrates, for lobe-aware numerics.
+
+    The albedo engine integrates in the frame of each lobe and the χ² sampling
+    tests choose their resolution from ``width``.
+
+    Attributes
+    ----------
+    kind : {"diffuse", "mirror", "half", "normal"}
+        ``diffuse``: broad, no preferred direction beyond the cosine.
+        ``mirror``: concentrated about the mirror direction R of the other
+        direction (Phong-type, a function of R·V).
+        ``half``: concentrated where the half vector H is near the normal
+        (Blinn/microfacet-type, a function of N·H).
+        ``normal``: concentrated about the normal (peaked separable models).
+    width : float
+        Angular half-width in radians (≈ the half-angle β at which the lobe
+        falls to half its peak, in the variable of ``kind``).
+    """
+
+    kind: str
+    width: float
+
+
+@dataclass(frozen=True)
+class Param:
+    """A model parameter, declared once.
+
+    Attributes
+    ----------
+    name : str
+        The paper's symbol in ASCII (``rho_d``, ``k_s``, ``n``, ``m`` ...).
+    default : float or str
+        Default value (a string for a choice parameter).
+    lower, upper : float
+        Bounds; ``lower_open`` / ``upper_open`` make them strict.
+    unit : str
+        Unit ("1/sr", "rad", "" for dimensionless).
+    doc : str
+        One line: what it means and guidance on values.
+    kind : {"scalar", "colour", "lobes", "choice"}
+        ``colour``: may be given per channel (a 1-D sequence, RGB or a
+        spectrum), broadcasting to a trailing channel axis of the output.
+        ``lobes``: may be a 1-D sequence, one value per lobe.
+        ``choice``: one of ``choices``.
+    choices : tuple of str
+        The allowed values of a choice parameter.
+    optional : bool
+        ``None`` is allowed and means "not given" (e.g. no index of refraction
+        means F = 1). Packed for the kernel as 0.0, which kernels test for.
+    """
+
+    name: str
+    default: float | str
+    lower: float = -math.inf
+    upper: float = math.inf
+    unit: str = ""
+    doc: str = ""
+    kind: str = "scalar"
+    choices: tuple[str, ...] = ()
+    lower_open: bool = False
+    upper_open: bool = False
+    optional: bool = False
+
+    def bounds_text(self) -> str:
+        """The allowed range as text, e.g. ``[0, 1]`` or ``(0, inf)``."""
+        if self.kind == "choice":
+            return "one of " + ", ".join(self.choices)
+        lo = "(" if self.lower_open else "["
+        hi = ")" if self.upper_open or math.isinf(self.upper) else "]"
+        if math.isinf(self.lower):
+            lo = "("
+        return f"{lo}{_fmt(self.lower)}, {_fmt(self.upper)}{hi}"
+
+    def validate(self, value, model: str):
+        """Return *value* converted (float, float array, str or None); raise if invalid."""
+        if value is None and self.optional:
+            return None
+        if type(value) is float and self.kind != "choice" and self._inside(value):
+            return value  # the common case (a fit builds a model per evaluation): no array
+        if self.kind == "choice":
+            if not isinstance(value, str) or value.lower() not in self.choices:
+                raise ParameterError(
+                    f"{model}: parameter {self.name!r} must be {self.bounds_text()}; got {value!r}"
+                )
+            return value.lower()
+        try:
+            arr = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ParameterError(
+                f"{model}: parameter {self.name!r} must be a number in {self.bounds_text()}; "
+                f"got {value!r}"
+            ) from None
+        if arr.ndim > 1 or (arr.ndim == 1 and self.kind == "scalar"):
+            allowed = "a number" if self.kind == "scalar" else "a number or a 1-D sequence"
+            raise ParameterError(
+                f"{model}: parameter {self.name!r} must be {allowed}; got shape {arr.shape}"
+            )
+        if arr.ndim == 1 and arr.size == 0:
+            raise ParameterError(f"{model}: parameter {self.name!r} is an empty sequence")
+        for x in np.atleast_1d(arr):
+            if not self._inside(float(x)):
+                raise ParameterError(
+                    f"{model}: parameter {self.name!r} must lie in {self.bounds_text()}"
+                    f"{' ' + self.unit if self.unit else ''}; got {_fmt(float(x))}"
+                )
+        return float(arr) if arr.ndim == 0 else arr.copy()
+
+    def _inside(self, x: float) -> bool:
+        if not math.isfinite(x):
+            return False
+        lo_ok = x > self.lower if self.lower_open else x >= self.lower
+        hi_ok = x < self.upper if self.upper_open else x <= self.upper
+        return lo_ok and hi_ok
+
+    def to_dict(self) -> dict:
+        """JSON-ready description (used by ``brdfkit models --json``)."""
+        d = {"name": self.name, "default": self.default, "kind": self.kind,
+             "unit": self.unit, "doc": self.doc, "optional": self.optional}
+        if self.kind == "choice":
+            d["choices"] = list(self.choices)
+        else:
+            d["lower"] = None if math.isinf(self.lower) else self.lower
+            d["upper"] = None if math.isinf(self.upper) else self.upper
+            d["bounds"] = self.bounds_text()
+        return d
+
+
+def _fmt(x: float) -> str:
+    if math.isinf(x):
+        return "inf" if x > 0 else "-inf"
+    return f"{x:g}"
+
+
+
+def _check_beta(model: str, beta) -> float:
+    try:
+        b = float(beta)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{model}: 'beta' must be a number (radians); got {beta!r}") from None
+    if not (0.0 < b < math.pi / 2):
+        raise ParameterError(
+            f"{model}: 'beta' (half-angle) must lie in (0, pi/2) rad = (0, 90) deg; got {b:g} rad"
+        )
+    return b
