@@ -27,7 +27,8 @@ import numpy as np
 
 import brdfkit
 import brdfkit.data as bd
-from brdfkit.data.merl import MeasuredBRDF, table_from_function
+from brdfkit.data.measured import MeasuredBRDF
+from brdfkit.data.merl import table_from_function
 from brdfkit.data.sampler import tabulated_strategy
 from brdfkit.geometry import pdf_cosine_hemisphere, sample_cosine_hemisphere
 from brdfkit.models.sampling import COSINE

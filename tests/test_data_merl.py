@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 
 import brdfkit
+from brdfkit.data.measured import MeasuredBRDF
 from brdfkit.data.merl import (
     N_BINS,
     SHAPE,
-    MeasuredBRDF,
     MerlTable,
     bin_centres,
     half_diff_to_directions,

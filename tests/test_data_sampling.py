@@ -26,7 +26,8 @@ import brdfkit.data as bd
 from brdfkit.analysis import albedo, albedo_mc, check
 from brdfkit.analysis.chi2 import chi2_test
 from brdfkit.analysis.plausibility import reciprocity
-from brdfkit.data.merl import MeasuredBRDF, read_binary, table_from_function, write_binary
+from brdfkit.data.measured import MeasuredBRDF
+from brdfkit.data.merl import read_binary, table_from_function, write_binary
 from brdfkit.models.diffuse import Lambert
 from brdfkit.models.sampling import HalfVector, PowerHalf, StrategySampled
 from brdfkit.models.tabulated_sampling import TabulatedHalfVector, sample_linear

@@ -27,7 +27,8 @@ import pytest
 import brdfkit.data as bd
 from brdfkit.analysis.albedo_engine import albedo
 from brdfkit.data import catalog
-from brdfkit.data.merl import MeasuredBRDF, bin_centres, half_diff_to_directions
+from brdfkit.data.measured import MeasuredBRDF
+from brdfkit.data.merl import bin_centres, half_diff_to_directions
 from brdfkit.data.surrogates import SurrogateBRDF, nbrdf_kernel
 from brdfkit.errors import UnknownModelError
 from brdfkit.models import BRDF

@@ -6,7 +6,9 @@ The data layer (layer 2 in ``docs/architecture.md``): tabulated and measured
 BRDFs as brdfkit models.
 
 - :mod:`brdfkit.data.merl` — the MERL ``.binary`` format read and written
-  exactly, the reference reader's lookup, :class:`~brdfkit.data.merl.MeasuredBRDF`.
+  exactly, the reference reader's bins, the grid.
+- :mod:`brdfkit.data.measured` — :class:`~brdfkit.data.measured.MeasuredBRDF`, a MERL
+  table as a model (its compiled lookups).
 - :mod:`brdfkit.data.surrogates` — compiled kernels and builders of the compact
   surrogates (NBRDF, NPF, ABC, SGD).
 - :mod:`brdfkit.data.surrogate_model` — :class:`~brdfkit.data.surrogate_model.SurrogateBRDF`,
@@ -37,13 +39,8 @@ from brdfkit.data.catalog import (
     material_names,
     materials,
 )
-from brdfkit.data.merl import (
-    MeasuredBRDF,
-    MerlTable,
-    read_binary,
-    table_from_function,
-    write_binary,
-)
+from brdfkit.data.measured import MeasuredBRDF
+from brdfkit.data.merl import MerlTable, read_binary, table_from_function, write_binary
 from brdfkit.data.surrogates import SurrogateBRDF
 
 __all__ = ["MaterialInfo", "MeasuredBRDF", "MerlTable", "SurrogateBRDF", "is_material_spec",

@@ -6,7 +6,7 @@ The half/difference angles of a direction pair as MERL's reference reader
 (``BRDFRead.cpp``) computes them, its bin index formulas, a fast nearest
 index that gives the same indices without acos/atan2, and the trilinear cell
 of the ``linear`` lookup. Used by :mod:`brdfkit.data.merl` (formats, the
-drivers and :class:`~brdfkit.data.merl.MeasuredBRDF`); see its docstring for
+drivers and :class:`~brdfkit.data.measured.MeasuredBRDF`); see its docstring for
 the formulas and [Matusik2003], [Rusinkiewicz1998].
 
 The fast nearest index (:func:`_fast_index`)

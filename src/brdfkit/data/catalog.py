@@ -19,7 +19,7 @@ spec                                    material
 ``rgl:NAME``                            RGL-EPFL material (``_rgb`` suffix optional)
 ``nielsen:NAME``                        Nielsen et al. 2015 material
 ``PATH.binary`` (or an ``os.PathLike``) a MERL ``.binary`` file
-                                        (:class:`~brdfkit.data.merl.MeasuredBRDF`)
+                                        (:class:`~brdfkit.data.measured.MeasuredBRDF`)
 ======================================  ==========================================
 
 Names are case-insensitive; ``-`` and ``_`` are interchangeable. An unknown
@@ -57,7 +57,8 @@ from importlib import resources
 
 import numpy as np
 
-from brdfkit.data.merl import MeasuredBRDF, read_binary
+from brdfkit.data.measured import MeasuredBRDF
+from brdfkit.data.merl import read_binary
 from brdfkit.data.surrogates import (
     REPRESENTATIONS,
     SGD_FIELDS,

@@ -33,7 +33,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from brdfkit.data.merl import MeasuredBRDF, MerlTable, table_from_function, write_binary
+from brdfkit.data.measured import MeasuredBRDF
+from brdfkit.data.merl import MerlTable, table_from_function, write_binary
 from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
 

@@ -4,9 +4,10 @@ The MERL ``.binary`` format, exactly
 
 Matusik et al. (2003) store an isotropic BRDF on a half/difference-angle grid
 of 90 θ_h × 90 θ_d × 180 φ_d bins, three colour channels. This module reads
-and writes that format bit-exactly, looks values up exactly as MERL's
-reference reader (``BRDFRead.cpp``) does, and turns a table into a brdfkit
-model (:class:`MeasuredBRDF`).
+and writes that format bit-exactly and finds the bins of direction pairs
+exactly as MERL's reference reader (``BRDFRead.cpp``) does; a table becomes a
+brdfkit model in :mod:`brdfkit.data.measured`
+(:class:`~brdfkit.data.measured.MeasuredBRDF`).
 
 File layout
 -----------
@@ -21,7 +22,7 @@ File layout
   can round to one scaled value).
 - negative entries mark bins that were not measured. brdfkit keeps them as a
   **validity mask** (:attr:`MerlTable.valid`): never reflectance 0, never
-  silently clamped (see :class:`MeasuredBRDF`'s ``invalid`` parameter).
+  silently clamped (see :class:`~brdfkit.data.measured.MeasuredBRDF`).
 
 Lookup (``BRDFRead.cpp``, ``lookup_brdf_val``)
 ----------------------------------------------
@@ -35,8 +36,7 @@ u_θd = θ_d/(π/2)·90, u_φd = φ_d/π·180; centres at i + ½; θ_h and θ_d 
 the ends, φ_d periodic with period π — φ_d and φ_d + π are the same bin).
 The compiled lookups find the same ``nearest`` bin without acos/atan2
 (exact step tables of h_z and d_z, φ_d boundary side tests:
-:mod:`brdfkit.data._merl_index`), in blocks whose bins are found first and
-then read (random reads of the 35 MB table overlap).
+:mod:`brdfkit.data._merl_index`).
 
 Public objects
 --------------
@@ -44,7 +44,7 @@ Public objects
 - :func:`read_binary`, :func:`write_binary` — exact I/O with precise errors.
 - :func:`merl_indices` — the reference reader's bin indices of direction pairs.
 - :func:`table_from_function` — tabulate any f(wi, wo) on the MERL grid.
-- :class:`MeasuredBRDF` — a tabulated material as a brdfkit model.
+- :func:`bin_centres`, :func:`half_diff_to_directions` — the grid's angles, as directions.
 - :data:`SCALES`, :data:`SHAPE`, :data:`N_BINS`.
 
 References
@@ -58,7 +58,6 @@ References
 
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass
 
@@ -67,24 +66,14 @@ import numpy as np
 
 from brdfkit._io import write_atomic
 from brdfkit.data._merl_index import (
-    _NQ,
-    _fast_index,
-    _half_diff,
-    _half_diff_vec,
     _index_tables,
     _indices,
     _indices_formula,
-    _linear,
-    _linear_coords,
-    _linear_sum,
-    _nearest_index,
 )
-from brdfkit.data.sampler import TabulatedSampler
 from brdfkit.errors import DataFileError, ParameterError
-from brdfkit.models._base import DerivedBRDF, Lobe, Param, _unit_pair
 
 __all__ = ["MerlTable", "read_binary", "write_binary", "merl_indices", "table_from_function",
-           "MeasuredBRDF", "SCALES", "SHAPE", "N_BINS"]
+           "bin_centres", "half_diff_to_directions", "SCALES", "SHAPE", "N_BINS"]
 
 #: Bins per axis: θ_h, θ_d, φ_d (φ_d over [0, π): reciprocity folds [π, 2π) onto it).
 SHAPE = (90, 90, 180)
@@ -211,7 +200,8 @@ def merl_indices(wi, wo, *, method: str = "fast") -> np.ndarray:
     """Flat bin index (``i_φd + 180 i_θd + 16200 i_θh``) of each pair, as ``BRDFRead.cpp``.
 
     ``method="formula"`` evaluates the reference's acos/atan2 formulas; ``"fast"`` (what
-    :class:`MeasuredBRDF` uses) gives the same indices without them (see _fast_index).
+    :class:`~brdfkit.data.measured.MeasuredBRDF` uses) gives the same indices without them
+    (see _fast_index).
     """
     from brdfkit._array import as_directions
 
@@ -229,122 +219,6 @@ def merl_indices(wi, wo, *, method: str = "fast") -> np.ndarray:
     else:
         _indices_formula(a, b, out)
     return out.reshape(shape[:-1])
-
-
-#: Offset of the table in a packed row: [lookup mode, table …].
-_TABLE = 1
-NEAREST, LINEAR = 0, 1
-
-
-@numba.njit(cache=True)
-def _measured_kernel(ix, iy, iz, ox, oy, oz, p):
-    if iz <= 0.0 or oz <= 0.0:
-        return 0.0
-    theta_h, theta_d, phi_d = _half_diff(ix, iy, iz, ox, oy, oz)
-    if p[0] == LINEAR:
-        return _linear(p, 1, _TABLE, theta_h, theta_d, phi_d)
-    return p[_TABLE + _nearest_index(theta_h, theta_d, phi_d)]
-
-
-#: Pairs per task of the table drivers: the bins of a block are found first (arithmetic),
-#: then read (random reads of a 35 MB table, cache and TLB misses): the reads of a block
-#: are independent, so the memory system serves many at once (measured on this 2-core
-#: machine: 1.7-2.2x one loop that finds and reads each pair's bin in turn).
-_BLOCK = 256
-_BAD, _BELOW = -2, -1  # block markers: not a finite unit pair; below the horizon
-
-
-@numba.njit(cache=True, inline="always")
-def _status(ix, iy, iz, ox, oy, oz):
-    """0 for a pair to look up, _BAD (not finite unit vectors), _BELOW (f_r = 0)."""
-    if not _unit_pair(ix, iy, iz, ox, oy, oz):
-        return _BAD
-    if iz <= 0.0 or oz <= 0.0:
-        return _BELOW
-    return 0
-
-
-@numba.njit(cache=True, inline="always")
-def _fill(out, j, n_channels, status):
-    """Row j of a pair that is not looked up: NaN (bad) or 0 (below the horizon)."""
-    v = math.nan if status == _BAD else 0.0
-    for c in range(n_channels):
-        out[j, c] = v
-
-
-@numba.njit(cache=True, parallel=True)
-def _nearest_driver(wi, wo, data, out):  # pragma: no cover - compiled
-    """:meth:`BRDF.eval`'s checked pass for the ``nearest`` lookup. ``data`` (flat): the
-    index tables (:func:`_index_tables`, _NQ numbers), then the channel-interleaved table
-    (bin i, channel c at ``_NQ + C·i + c``): the bin is found once per pair for all
-    channels, whose values share a cache line (the generic loop around
-    :func:`_measured_kernel` finds it per channel and reads three planar rows: ~3 cache
-    and TLB misses per random pair). Blocks of _BLOCK pairs. Returns the number of pairs
-    that are not finite unit vectors (their rows NaN), as the generic driver does."""
-    n = wi.shape[0]
-    n_channels = out.shape[1]
-    Q = data[:_NQ]
-    n_bad = 0
-    for q in numba.prange((n + _BLOCK - 1) // _BLOCK):
-        lo = q * _BLOCK
-        hi = min(n, lo + _BLOCK)
-        k = np.empty(_BLOCK, dtype=np.int64)  # the bin's offset in data, or a marker
-        for j in range(lo, hi):
-            ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
-            ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-            s = _status(ix, iy, iz, ox, oy, oz)
-            if s == 0:
-                hz, dx, dy, dz = _half_diff_vec(ix, iy, iz, ox, oy, oz)
-                k[j - lo] = _NQ + n_channels * _fast_index(hz, dx, dy, dz, Q)
-            else:
-                k[j - lo] = s
-        for j in range(lo, hi):
-            kj = k[j - lo]
-            if kj >= 0:
-                for c in range(n_channels):
-                    out[j, c] = data[kj + c]
-            else:
-                _fill(out, j, n_channels, kj)
-                if kj == _BAD:
-                    n_bad += 1
-    return n_bad
-
-
-@numba.njit(cache=True, parallel=True)
-def _linear_driver(wi, wo, data, out):  # pragma: no cover - compiled
-    """:func:`_nearest_driver` for the ``linear`` lookup (the same ``data``): the cell and
-    weights are computed once per pair for all channels."""
-    n = wi.shape[0]
-    n_channels = out.shape[1]
-    n_bad = 0
-    for q in numba.prange((n + _BLOCK - 1) // _BLOCK):
-        lo = q * _BLOCK
-        hi = min(n, lo + _BLOCK)
-        k = np.empty(_BLOCK, dtype=np.int64)  # the cell's first corner, or a marker
-        step = np.empty(_BLOCK, dtype=np.int64)
-        frac = np.empty((_BLOCK, 3))
-        for j in range(lo, hi):
-            ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
-            ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-            s = _status(ix, iy, iz, ox, oy, oz)
-            if s == 0:
-                theta_h, theta_d, phi_d = _half_diff(ix, iy, iz, ox, oy, oz)
-                i = j - lo
-                k[i], step[i], frac[i, 0], frac[i, 1], frac[i, 2] = _linear_coords(
-                    theta_h, theta_d, phi_d)
-            else:
-                k[j - lo] = s
-        for j in range(lo, hi):
-            i = j - lo
-            if k[i] >= 0:
-                for c in range(n_channels):
-                    out[j, c] = _linear_sum(data, n_channels, _NQ + c, k[i], step[i],
-                                            frac[i, 0], frac[i, 1], frac[i, 2])
-            else:
-                _fill(out, j, n_channels, k[i])
-                if k[i] == _BAD:
-                    n_bad += 1
-    return n_bad
 
 
 # --------------------------------------------------------------------------- tabulation
@@ -447,168 +321,3 @@ def table_from_function(f, *, source: str = "<function>") -> MerlTable:
     raw.flags.writeable = False  # MerlTable keeps a read-only array as it is (no copy)
     return MerlTable(raw.reshape(3, *SHAPE), source)
 
-
-# --------------------------------------------------------------------------- the model
-def _width_from_table(values: np.ndarray) -> float:
-    """Half-width (rad, in θ_h) of the tabulated peak: where the luminance-like mean over
-    channels, φ_d and θ_d < 10°, minus its floor, falls to half its value at θ_h = 0."""
-    th, _, _ = bin_centres()
-    v = np.where(np.isfinite(values), values, np.nan)
-    prof = np.nanmean(v[:, :, :10, :], axis=(0, 2, 3))
-    if not np.any(np.isfinite(prof)):
-        return 0.5 * math.pi
-    prof = np.nan_to_num(prof, nan=0.0)
-    floor = float(np.min(prof))
-    peak = float(prof[0]) - floor
-    if peak <= 0.0:
-        return 0.5 * math.pi
-    below = np.nonzero(prof - floor < 0.5 * peak)[0]
-    if below.size == 0:
-        return 0.5 * math.pi
-    return float(max(th[below[0]], th[0]))
-
-
-@numba.njit(cache=True)
-def _mirror_symmetric_kernel(v):  # pragma: no cover - compiled
-    for c in range(v.shape[0]):
-        for i in range(v.shape[1]):
-            for j in range(v.shape[2]):
-                for p in range(90):
-                    a = v[c, i, j, p]
-                    b = v[c, i, j, 179 - p]
-                    if a != a or b != b:  # NaN: unmeasured; must be so in both
-                        if not (a != a and b != b):
-                            return False
-                    elif abs(a - b) > 1e-9 * max(abs(a), abs(b)):
-                        return False
-    return True
-
-
-def _mirror_symmetric(values: np.ndarray) -> bool:
-    """Whether the table is even in the relative azimuth: f(ω_i, ω_o) = f(ω_i', ω_o') for
-    the pair mirrored in the plane of incidence. The mirror maps φ_d to −φ_d, which the
-    lookup folds to π − φ_d: bin i_φd ↔ 179 − i_φd (nearest) and bin centre ↔ bin centre
-    (linear). Compared to 1e-9 relative — the rounding of a tabulated symmetric function,
-    far below any measurement's noise; unmeasured bins (NaN) must be unmeasured in both.
-    A compiled loop that stops at the first asymmetric pair of bins."""
-    return bool(_mirror_symmetric_kernel(np.ascontiguousarray(values).reshape(3, 90, 90, 180)))
-
-
-class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
-    """A tabulated material on the MERL grid as a brdfkit model.
-
-    ======  ========  ===============  ========================================
-    name    default   choices          meaning
-    ======  ========  ===============  ========================================
-    lookup  nearest   nearest, linear  ``nearest``: the reference reader's bin
-                                       (values agree with every MERL tool);
-                                       ``linear``: trilinear between bin
-                                       centres (continuous: fitting, rendering)
-    ======  ========  ===============  ========================================
-
-    Unmeasured bins (negative in the file) are NaN in the model's table:
-    ``eval`` returns NaN where a ``nearest`` lookup lands on one (there is no
-    measurement there — never 0, never a clamp), ``linear`` interpolates over
-    the measured neighbours and is NaN only where all eight are unmeasured.
-    Analyses report NaN values (the albedo engine's status NONFINITE).
-
-    Albedo on tabulated data: the ``nearest`` table is piecewise constant with
-    jumps on the bin boundaries, which the adaptive quadrature cannot resolve
-    to 1e-7 — results carry status MAX_LEVEL_REACHED and an error estimate of
-    the jumps' size; use ``linear`` for albedos (continuous; converges to the
-    interpolant's albedo).
-
-    Reciprocal by construction (the φ_d fold maps the swapped pair to the same
-    bin); f depends on the azimuths only through φ_i − φ_o (φ_h is dropped), and
-    is even in it — ``isotropic`` True, so the albedo engine integrates half the
-    azimuths — only when the table equals its mirror image, bin φ_d ↔ bin
-    179 − φ_d (:func:`_mirror_symmetric`; a mirrored pair's φ_d folds to
-    π − φ_d). A table of a reciprocal isotropic function is; a table of a
-    non-reciprocal one (each bin holds f(ω_i, ω_o) of its own centre only) or a
-    noisy measurement is not, and declares ``isotropic`` False (the engine then
-    integrates all azimuths: halving cost 1.1 % of the albedo of a tabulated
-    Lewis Phong at θ_i = 20° while reporting 3e-6 error).
-
-    Sampling: from the table's own values (:mod:`brdfkit.data.sampler`: per-θ_o
-    bilinear half-vector tables of f̄ cos θ_i mixed with the cosine), built on
-    the first ``sample``/``pdf`` (~50 ms); the density is positive on the whole
-    upper hemisphere, unmeasured bins included.
-
-    Plausibility verdicts (:func:`brdfkit.analysis.check`) on measured data:
-    *reciprocal* is a property of the lookup, not of the measurement — MERL
-    stores one value per (θ_h, θ_d, φ_d mod π) bin, and swapping ω_i and ω_o
-    only flips φ_d by π, so every table is reciprocal whatever was measured
-    (a verdict about the storage, not evidence that the material is). With
-    ``nearest`` the indices are computed from ω_i (as the reference reader), and
-    a pair on a bin edge can round to the neighbouring bin when swapped: the
-    verdict is then "not reciprocal" by the difference of two neighbouring bins
-    (2e-6 for a smooth tabulated Phong; measured noise is larger). ``linear``
-    is reciprocal to rounding. Pairs that land on unmeasured bins are left
-    out of the verdict and counted in its notes. *Energy*:
-    a ``nearest`` table's albedo does not converge to the engine's tolerance
-    (jumps at bin edges), so the verdict is ``undetermined`` when the maximum
-    albedo lies within its error estimate of 1 and otherwise reflects the
-    table's albedo ± that error; unmeasured bins make the albedo NaN where they
-    are reached and the verdict ``undetermined`` (no value is invented for them).
-    """
-
-    def __init__(self, table: MerlTable, *, name: str | None = None, lookup: str = "nearest",
-                 citation: str = ("Matusik et al. 2003 (MERL BRDF database, CC-BY-SA-4.0); "
-                                  "MERL .binary format")):
-        if not isinstance(table, MerlTable):
-            raise ParameterError(f"MeasuredBRDF: table must be a MerlTable (read_binary); got "
-                                 f"{type(table).__name__}")
-        self.table = table
-        values = np.where(table.valid, table.values, np.nan).reshape(3, N_BINS)
-        self._values_table = values
-        self._interleaved = None  # built on the first eval (see _driver_data)
-        self._width = _width_from_table(values.reshape(3, *SHAPE))
-        label = name or f"merl-file:{os.path.basename(table.source)}"
-        super().__init__(
-            name=label, params=(Param("lookup", "nearest", kind="choice",
-                                      choices=("nearest", "linear"),
-                                      doc="nearest bin (reference reader) or trilinear"),),
-            values={"lookup": lookup}, citation=citation,
-            summary=f"tabulated material ({table.source}), MERL grid 90x90x180",
-            reciprocal=True, has_sampler=True, kernel=_measured_kernel,
-            isotropic=_mirror_symmetric(values))
-        self.n_channels = 3
-        # one bin computation per pair for all channels
-        self._driver = (_linear_driver if self._values["lookup"] == "linear"
-                        else _nearest_driver)
-
-    def _pack(self) -> np.ndarray:
-        mode = LINEAR if self._values["lookup"] == "linear" else NEAREST
-        out = np.empty((3, _TABLE + N_BINS))
-        out[:, 0] = mode
-        out[:, _TABLE:] = self._values_table
-        return out
-
-    def _driver_data(self) -> np.ndarray:
-        """What :func:`_nearest_driver` and :func:`_linear_driver` read (built once): the
-        index tables, then the channel-interleaved table."""
-        if self._interleaved is None:
-            t = np.empty(_NQ + 3 * N_BINS)
-            t[:_NQ] = _index_tables()
-            t[_NQ:] = self._values_table.T.reshape(-1)
-            t.flags.writeable = False
-            self._interleaved = t
-        return self._interleaved
-
-    def lobes(self):
-        return [Lobe("diffuse", 0.5 * math.pi), Lobe("half", self._width)]
-
-    def with_params(self, **changes) -> MeasuredBRDF:
-        unknown = set(changes) - {"lookup"}
-        if unknown:
-            raise ParameterError(f"{self.name}: unknown parameter {sorted(unknown)[0]!r}; valid "
-                                 "parameters: lookup")
-        return MeasuredBRDF(self.table, name=self.name,
-                            lookup=changes.get("lookup", self._values["lookup"]),
-                            citation=self.citation)
-
-    def to_dict(self) -> dict:
-        return {"model": self.name, "params": dict(self._values)}
-
-    def __repr__(self) -> str:
-        return f"MeasuredBRDF({self.table.source!r}, lookup={self._values['lookup']!r})"
