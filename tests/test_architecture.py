@@ -3,7 +3,8 @@
 - A module imports only from its own layer and the layers below (imports inside
   functions count too).
 - No brdfkit module is imported inside ``try/except ImportError`` (self-guarding).
-- No source file over ~800 lines (issue 8; 850 allows the "~").
+- No source file over 600 lines (issue 18: modules by concept); the files still being
+  split by other work are listed in OVER_LIMIT until they are.
 - No engine probes a model with getattr/hasattr for a protocol hook.
 """
 
@@ -19,7 +20,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "brdfkit"
 #: docs/architecture.md, "Layers"
 LAYER = {
     "errors": 0, "_array": 0, "_kern": 0, "geometry": 0, "fresnel": 0, "halfangle": 0,
-    "tables": 0, "_io": 0, "_dual": 0, "status": 0,
+    "tables": 0, "_io": 0, "_dual": 0, "status": 0, "_cache": 0,
     # the package root is the public facade (brdfkit.model resolves model names and
     # material specs): layer 2, so the data layer is below it and cli/figures above
     "": 2, "_specs": 2, "models": 1,
@@ -27,7 +28,16 @@ LAYER = {
     "pumping": 3, "fitting": 3, "render": 3,
     "figures": 4, "cli": 4, "report": 4, "explorer": 4, "__main__": 4,
 }
-MAX_LINES = 850
+MAX_LINES = 600
+#: Files over MAX_LINES whose split is owned by other parts of issue 18 (helpers "results",
+#: "loops", "fitting"). Each keeps the former cap of 850 until its split is merged; the
+#: coordinator empties this after merging them (an entry under the cap fails, so a merged
+#: split must also leave this list).
+OVER_LIMIT = {
+    "analysis/albedo_engine.py": 850,  # helper "results": albedo engine vs Monte Carlo
+    "models/microfacet.py": 850,  # helper "loops": one module per microfacet family
+    "fitting/procedure.py": 850,  # helper "fitting": fitting as stages
+}
 #: hooks of the model protocol that must be read as declared attributes, never probed
 HOOKS = {"isotropic", "specular_albedo", "albedo_kinks", "albedo_kinks_nv", "albedo_kink_mus",
          "has_delta", "has_sampler", "lobes", "sharpest_lobe", "kernel", "packed", "n_channels",
@@ -96,7 +106,16 @@ def test_no_self_guarding_imports(path):
 @pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(SRC)))
 def test_source_files_are_not_too_long(path):
     n = len(path.read_text().splitlines())
-    assert n <= MAX_LINES, f"{path} has {n} lines (> {MAX_LINES}): split it"
+    rel = path.relative_to(SRC).as_posix()
+    cap = OVER_LIMIT.get(rel, MAX_LINES)
+    assert n <= cap, f"{path} has {n} lines (> {cap}): split it (one module per concept)"
+
+
+@pytest.mark.parametrize("rel", sorted(OVER_LIMIT))
+def test_over_limit_list_is_current(rel):
+    # an entry must still be needed: once its file is split below the cap, remove it
+    n = len((SRC / rel).read_text().splitlines())
+    assert n > MAX_LINES, f"{rel} has {n} lines (<= {MAX_LINES}): remove it from OVER_LIMIT"
 
 
 @pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(SRC)))

@@ -44,6 +44,8 @@ Public objects
   measured materials (:mod:`brdfkit.data`).
 - :data:`brdfkit.MODELS` — the registry: canonical name → model class.
 - :func:`brdfkit.model_names` — the canonical names.
+- :func:`brdfkit.clear_caches` / :func:`brdfkit.cache_info` — every in-process cache
+  (bounded, registered: :mod:`brdfkit._cache`).
 - :mod:`brdfkit.geometry`, :mod:`brdfkit.fresnel`, :mod:`brdfkit.halfangle`
   — the shared parts the models are built from.
 
@@ -58,6 +60,7 @@ References
   *Microfacet Models for Refraction through Rough Surfaces*, EGSR 2007.
 """
 
+from brdfkit._cache import cache_info, clear_caches
 from brdfkit._specs import model, model_params
 from brdfkit.data import material, materials
 from brdfkit.errors import BrdfkitError, ParameterError, UnknownModelError
@@ -70,6 +73,8 @@ __all__ = [
     "Param",
     "ParameterError",
     "UnknownModelError",
+    "cache_info",
+    "clear_caches",
     "material",
     "materials",
     "model",

@@ -65,6 +65,7 @@ from dataclasses import dataclass
 
 import numba
 
+from brdfkit._cache import bounded_cache
 from brdfkit._kern import exp_nonpos
 
 __all__ = ["Formulas", "formula", "primitive", "drjit_version", "select", "sqrt", "exp", "log",
@@ -76,7 +77,9 @@ _jit = numba.njit(cache=True, inline="always")
 _FORMULAS: dict[Callable, object] = {}
 #: Numba-side primitive object → factory dr ↦ its Dr.Jit counterpart
 _PRIMITIVES: dict[object, Callable] = {}
-_DRJIT: dict[Callable, Callable] = {}  # memo: py_func → Dr.Jit version
+#: memo: py_func → Dr.Jit version (every formula and primitive user: tens; the bound is far
+#: above them, so a trace never rebuilds a callee)
+_DRJIT = bounded_cache("brdfkit._dual._DRJIT", maxsize=256)
 
 
 @dataclass(frozen=True)

@@ -38,6 +38,7 @@ import math
 import numba
 import numpy as np
 
+from brdfkit._cache import memo
 from brdfkit._dual import absolute, formula, maximum, minimum, select, sqrt
 
 __all__ = ["fresnel_dielectric", "fresnel_conductor", "fresnel_schlick", "f0_from_eta"]
@@ -120,14 +121,12 @@ _UFUNC_SPECS = {
     "conductor": ("float64(float64, float64, float64)", _fresnel_conductor_py),
     "schlick": ("float64(float64, float64)", _fresnel_schlick_py),
 }
-_ufuncs: dict = {}
 
 
+@memo(maxsize=len(_UFUNC_SPECS))  # one per array version (a rebuild costs 0.1-0.3 s)
 def _ufunc(name: str):
-    if name not in _ufuncs:
-        signature, py_func = _UFUNC_SPECS[name]
-        _ufuncs[name] = numba.vectorize([signature], cache=True)(py_func)
-    return _ufuncs[name]
+    signature, py_func = _UFUNC_SPECS[name]
+    return numba.vectorize([signature], cache=True)(py_func)
 
 
 def _check_positive(name: str, value) -> np.ndarray:

@@ -33,11 +33,12 @@ References
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numba
 import numpy as np
+
+from brdfkit._cache import memo
 
 
 @numba.njit(cache=True, inline="always")
@@ -262,7 +263,7 @@ def _steps(which, T):  # pragma: no cover - compiled
     return ok
 
 
-@functools.cache
+@memo(maxsize=1)  # one set of tables per process (a few kB)
 def _index_tables() -> np.ndarray:
     """The tables of :func:`_fast_index` (built once per process, milliseconds).
 

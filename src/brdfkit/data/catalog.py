@@ -48,7 +48,6 @@ from __future__ import annotations
 
 import csv
 import difflib
-import functools
 import io
 import math
 import os
@@ -57,6 +56,7 @@ from importlib import resources
 
 import numpy as np
 
+from brdfkit._cache import memo
 from brdfkit.data.measured import MeasuredBRDF
 from brdfkit.data.merl import read_binary
 from brdfkit.data.surrogates import (
@@ -99,7 +99,7 @@ def data_file(name: str):
 
 
 # --------------------------------------------------------------------------- file readers
-@functools.cache
+@memo(maxsize=4)  # one per NBRDF file (merl, rgl, nielsen); ~3 MB in all
 def _nbrdf_weights(source: str) -> dict:
     name = _NBRDF_FILES[source]
     with data_file(name).open("rb") as fh:
@@ -113,7 +113,7 @@ def _nbrdf_weights(source: str) -> dict:
     return {"names": names, "index": {n: i for i, n in enumerate(names)}, **arrays}
 
 
-@functools.cache
+@memo(maxsize=1)  # the one NPF file (~1.3 MB)
 def _npf_table() -> tuple[np.ndarray, dict]:
     raw = data_file(_NPF_FILE).read_bytes()
     expected = 4 * math.prod(_NPF_SHAPE)
@@ -134,17 +134,17 @@ def _read_csv(name: str) -> dict:
     return {r["material"]: r for r in csv.DictReader(io.StringIO(text))}
 
 
-@functools.cache
+@memo(maxsize=1)  # the one ABC file
 def _abc_rows() -> dict:
     return _read_csv(_ABC_FILE)
 
 
-@functools.cache
+@memo(maxsize=1)  # the one SGD file
 def _sgd_rows() -> dict:
     return _read_csv(_SGD_FILE)
 
 
-@functools.cache
+@memo(maxsize=4)  # one per source
 def _names(source: str) -> tuple[str, ...]:
     return tuple(_nbrdf_weights(source)["names"])
 
@@ -153,7 +153,7 @@ def _key(name: str) -> str:
     return name.strip().lower().replace("_", "-")
 
 
-@functools.cache
+@memo(maxsize=4)  # one per source
 def _lookup(source: str) -> dict:
     """Normalised name → canonical name (RGL: also without the ``_rgb`` suffix)."""
     out = {}
@@ -165,7 +165,9 @@ def _lookup(source: str) -> dict:
 
 
 # --------------------------------------------------------------------------- building
-@functools.cache
+# every built-in material (459 with the NPF, ABC and SGD fits; a few kB each before a
+# sampler is built), so the same spec gives the same object
+@memo(maxsize=512)
 def _build(source: str, name: str, representation: str) -> SurrogateBRDF:
     if representation == "nbrdf":
         w = _nbrdf_weights(source)
@@ -338,7 +340,7 @@ class MaterialInfo:
                 "rho_d": None if self.rho_d is None else list(self.rho_d)}
 
 
-@functools.cache
+@memo(maxsize=512)  # one per built-in material (459), a few numbers each
 def _info(spec: str) -> MaterialInfo:
     m = material(spec)
     a = tuple(round(float(x), 6) for x in normal_albedo(m))

@@ -40,13 +40,13 @@ import math
 import tempfile
 import threading
 import time
-from collections import OrderedDict
 from importlib import resources
 from pathlib import Path
 
 from fastapi import FastAPI, Request
 from fastapi.responses import HTMLResponse, JSONResponse, Response
 
+from brdfkit._cache import bounded_cache
 from brdfkit._io import to_jsonable
 from brdfkit._specs import model as build_spec
 from brdfkit.data import material_names
@@ -58,6 +58,8 @@ from brdfkit.pumping import MAX_TIMES, pump
 
 __all__ = ["create_app", "build_entry", "parse_state"]
 
+#: Models and view sets kept per app (LRU): a session flips between a few models; a pumped
+#: model holds its tables (up to a few MB)
 _CACHE_SIZE = 64
 
 
@@ -130,7 +132,7 @@ def _b64(png: bytes) -> str:
 def create_app():
     """The FastAPI application (one model cache per app)."""
     app = FastAPI(title="brdfkit explorer", docs_url=None, redoc_url=None)
-    cache: OrderedDict = OrderedDict()
+    cache = bounded_cache(None, maxsize=_CACHE_SIZE)  # this app's models and views
     static = resources.files("brdfkit.explorer") / "static"
 
     def _key(entry: dict) -> str:
@@ -138,12 +140,10 @@ def create_app():
                           sort_keys=True)
 
     def _cached(key, make):
-        if key not in cache:
-            cache[key] = make()
-            if len(cache) > _CACHE_SIZE:
-                cache.popitem(last=False)
-        cache.move_to_end(key)
-        return cache[key]
+        got = cache.get(key)
+        if got is None:
+            got = cache[key] = make()
+        return got
 
     def get_model(entry: dict):
         return _cached(_key(entry), lambda: build_entry(entry))

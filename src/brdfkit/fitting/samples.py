@@ -57,12 +57,12 @@ target are integrated with the same nodes.
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from brdfkit._cache import memo
 from brdfkit.data.merl import SHAPE, half_diff_to_directions
 from brdfkit.errors import ParameterError
 
@@ -147,7 +147,7 @@ def _read_only(*arrays):
 
 # Memoised (every fit of a batch, and each fit's nested and root fits, uses the same few
 # grids; building one costs ~3 ms): the arrays are shared, hence read-only.
-@functools.lru_cache(maxsize=16)
+@memo(maxsize=16)
 def _merl_samples(sd: int, sp: int, theta_max: float | None) -> Samples:
     h, d, p = _edges()
     d_c, p_c = d[::sd], p[::sp]
@@ -187,7 +187,7 @@ def albedo_nodes(theta_deg=ALBEDO_THETA_DEG, *, n_u: int = 48, n_phi: int = 24):
     return _albedo_nodes(theta, int(n_u), int(n_phi))
 
 
-@functools.lru_cache(maxsize=16)
+@memo(maxsize=16)  # a few node sets per session (~1 MB each at the defaults)
 def _albedo_nodes(theta_deg: tuple, n_u: int, n_phi: int):
     theta = np.radians(np.asarray(theta_deg, dtype=np.float64))
     u = (np.arange(n_u) + 0.5) / n_u

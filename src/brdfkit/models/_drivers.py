@@ -59,6 +59,8 @@ from pathlib import Path
 import numba
 import numpy as np
 
+from brdfkit._cache import bounded_cache, memo
+
 __all__ = ["SERIAL_BELOW", "UNIT_TOL", "VECTOR_OPTIONS", "eval_pairs", "eval_pairs_checked",
            "checked_driver", "cached_driver", "cache_dir"]
 
@@ -272,8 +274,9 @@ def _loop_body() -> str:
     return textwrap.indent("\n".join(ast.unparse(stmt) for stmt in body), "    ") + "\n"
 
 
-_drivers: dict[int, object] = {}  # id(kernel) -> driver or None (kernels live as long)
-_stamp: str | None = None
+#: id(kernel) -> driver or None (kernels live as long; a driver module keeps its kernel):
+#: one per kernel in use, far below the bound
+_drivers = bounded_cache("brdfkit.models._drivers._drivers", maxsize=1024)
 
 
 def cache_dir() -> Path:
@@ -285,17 +288,15 @@ def cache_dir() -> Path:
     return Path(root) / "drivers"
 
 
+@memo(maxsize=1)  # once per process
 def _source_stamp() -> str:
     """Hash of every brdfkit source file's (path, size, mtime) and the tool versions."""
-    global _stamp
-    if _stamp is None:
-        package = Path(__file__).resolve().parents[1]
-        h = hashlib.sha256(f"{sys.version}|{numba.__version__}|{package}".encode())
-        for path in sorted(package.rglob("*.py")):
-            st = path.stat()
-            h.update(f"{path.relative_to(package)}|{st.st_size}|{st.st_mtime_ns}\n".encode())
-        _stamp = h.hexdigest()[:16]
-    return _stamp
+    package = Path(__file__).resolve().parents[1]
+    h = hashlib.sha256(f"{sys.version}|{numba.__version__}|{package}".encode())
+    for path in sorted(package.rglob("*.py")):
+        st = path.stat()
+        h.update(f"{path.relative_to(package)}|{st.st_size}|{st.st_mtime_ns}\n".encode())
+    return h.hexdigest()[:16]
 
 
 def _resolve(module: str, qualname: str):

@@ -50,13 +50,13 @@ References
 
 from __future__ import annotations
 
-import functools
 import importlib
 import math
 
 import numba
 import numpy as np
 
+from brdfkit._cache import memo
 from brdfkit._kern import INV_PI, INV_TWO_PI, below_horizon, n_dot_h, r_dot_v
 from brdfkit.halfangle import beta_from_exponent
 from brdfkit.models._base import Lobe, Param
@@ -117,7 +117,9 @@ def __getattr__(name: str):
 HS_LOOKUP_TOL = 1e-9
 
 
-@functools.lru_cache(maxsize=64)
+# 64 (n, lobe) pairs: a fit or a figure series revisits a few exponents; each lookup is a
+# few thousand nodes (tens of kB) and costs 0.1-5 s to build
+@memo(maxsize=64)
 def _hs_table(n: float, lobe: str) -> Lookup:
     """H_s(θ_i) of *lobe* and *n* as the shared compiled lookup in μ = cos θ_i.
 

@@ -21,12 +21,15 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from brdfkit._cache import bounded_cache
 from brdfkit.models._base import checked_driver
 from brdfkit.tables import _lookup
 
 __all__ = ["G_NUMPY", "chain_kernel", "stage_kernel"]
 
-_KERNELS: dict = {}
+#: (kernel, structure) → (kernel, driver): one per pumped structure in use (each a compiled
+#: kernel and loop, seconds to build; a session uses a few)
+_KERNELS = bounded_cache("brdfkit.pumping.kernels._KERNELS", maxsize=256)
 
 
 def chain_kernel(root_kernel, k: int, capped: bool):

@@ -61,10 +61,10 @@ from __future__ import annotations
 
 import math
 import time
-from collections import OrderedDict
 
 import numpy as np
 
+from brdfkit._cache import bounded_cache
 from brdfkit.errors import BrdfkitError
 from brdfkit.pumping.operator import G_FLOOR, PumpedBRDF
 from brdfkit.pumping.table import ENGINE_ERR, THETA_TOP, build_albedo_table
@@ -97,7 +97,7 @@ AFFINE_RTOL = 1e-9
 #: grid variable over [0, THETA_TOP]).
 _MU_CHECK = mu_of_w(np.linspace(float(w_of_mu(math.cos(THETA_TOP))), 1.0, 129))
 
-_NODE_CACHE: OrderedDict = OrderedDict()
+_NODE_CACHE = bounded_cache("brdfkit.pumping.surrogate._NODE_CACHE", maxsize=NODE_CACHE_SIZE)
 
 
 def _freeze(v):
@@ -188,7 +188,9 @@ class PumpSurrogate:
         self._const = {k: v for k, v in self.root.values.items()
                        if k not in linear and k not in shape}
         self._const_key = tuple(sorted((k, _freeze(v)) for k, v in self._const.items()))
-        self._mu_cache: dict = {}
+        # (cell, cosines) → the bases' albedos there: 256 keys bound the memory (a new set
+        # of pairs per key)
+        self._mu_cache = bounded_cache(None, maxsize=256)
         self._default_node = tuple(g.stencil(float(decl[g.name].default))[0] + 1
                                    for g in grids)
         self._static = _static_bases(self)
@@ -208,7 +210,6 @@ class PumpSurrogate:
         key = (type(self.root), self._const_key, self.shape, self.linear, self._static, node)
         got = _NODE_CACHE.get(key)
         if got is not None:
-            _NODE_CACHE.move_to_end(key)
             return got
         t0 = time.perf_counter()
         at = self._default_node if node == "static" else node
@@ -217,8 +218,6 @@ class PumpSurrogate:
                                      engine_tol=NODE_ENGINE_TOL)
                   for b in range(len(self._static)) if self._static[b] == (node == "static")]
         _NODE_CACHE[key] = tables
-        if len(_NODE_CACHE) > NODE_CACHE_SIZE:
-            _NODE_CACHE.popitem(last=False)
         self.n_tables += len(tables)
         self.table_time_s += time.perf_counter() - t0
         return tables
@@ -254,8 +253,6 @@ class PumpSurrogate:
         key = (cell, mu_key)
         stack = self._mu_cache.get(key)
         if stack is None:
-            if len(self._mu_cache) > 256:  # bound the memory (a new set of pairs per key)
-                self._mu_cache.clear()
             stack = np.stack([self._read(self._tables(node), mu) for node in self._nodes(cell)])
             self._mu_cache[key] = stack  # (4^d, dynamic bases, M, Cb)
         static = self._mu_cache.get(("static", mu_key))

@@ -40,13 +40,13 @@ References
 from __future__ import annotations
 
 import math
-import weakref
 from dataclasses import dataclass
 
 import numba
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from brdfkit._cache import bounded_cache
 from brdfkit.analysis import albedo
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models import BRDF, DerivedBRDF
@@ -63,7 +63,9 @@ MAX_TABLE_NODES = 4097
 #: Nodes of the first, uniform grid (16 intervals of at most 5.6°).
 _START_NODES = 17
 
-_SWAPPED: dict = {}
+#: kernel → its transposed compiled kernel: one per non-reciprocal model family rendered
+#: (a few; each a small compiled function)
+_SWAPPED = bounded_cache("brdfkit.render.ambient._SWAPPED", maxsize=64)
 
 
 def _swapped_kernel(kernel):
@@ -183,7 +185,9 @@ def _spline(theta, rho) -> CubicSpline:
     return CubicSpline(theta, rho, axis=0, bc_type=((1, np.zeros(rho.shape[1])), "not-a-knot"))
 
 
-_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+#: model object → its tables (weak: they go with the model); 64 models, each table a
+#: spline over at most MAX_TABLE_NODES nodes (≤ ~100 kB)
+_CACHE = bounded_cache("brdfkit.render.ambient._CACHE", maxsize=64, weak=True)
 
 
 def ambient_table(model: BRDF, *, theta_max: float, tol: float = RHO_TOL) -> AmbientTable:

@@ -97,6 +97,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from brdfkit._cache import bounded_cache
 from brdfkit._specs import model as build_model
 from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
@@ -110,7 +111,8 @@ from brdfkit.render.mitsuba_wavefront import wavefront, wavefront_class
 __all__ = ["FALLBACK", "ROUTES", "VARIANTS", "mitsuba_bsdf", "spectral_model", "use_variant",
            "wavefront"]
 
-_TRACED: dict[str, type] = {}
+#: variant → the traced BSDF class (one per variant)
+_TRACED = bounded_cache("brdfkit.render.mitsuba_bridge._TRACED", maxsize=len(VARIANTS))
 
 
 def use_variant(variant: str = "llvm_ad_rgb") -> str:

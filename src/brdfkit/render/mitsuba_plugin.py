@@ -21,15 +21,17 @@ from collections.abc import Callable
 
 import numpy as np
 
+from brdfkit._cache import bounded_cache
 from brdfkit._specs import model as build_model
 from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
 from brdfkit.pumping import pump
-from brdfkit.render.mitsuba_variants import import_mitsuba
+from brdfkit.render.mitsuba_variants import VARIANTS, import_mitsuba
 
 __all__ = ["register_plugin"]
 
-_REGISTERED: set[str] = set()
+#: variants the plugin is registered in (one entry per variant; cleared: registered again)
+_REGISTERED = bounded_cache("brdfkit.render.mitsuba_plugin._REGISTERED", maxsize=len(VARIANTS))
 
 
 def _parse_value(name: str, value):
@@ -88,4 +90,4 @@ def register_plugin(variant: str, make_bsdf: Callable) -> None:
         return make_bsdf(props, model, wavelengths, variant, "auto")
 
     mi.register_bsdf("brdfkit", plugin)
-    _REGISTERED.add(variant)
+    _REGISTERED[variant] = True

@@ -25,14 +25,16 @@ import contextlib
 
 import numpy as np
 
+from brdfkit._cache import bounded_cache
 from brdfkit.models import BRDF
 from brdfkit.render.mitsuba_colour import ColourMap, check_wavelengths
-from brdfkit.render.mitsuba_variants import import_mitsuba
+from brdfkit.render.mitsuba_variants import VARIANTS, import_mitsuba
 
 __all__ = ["wavefront", "wavefront_class"]
 
 _FLAGS = ("SymbolicLoops", "SymbolicCalls", "SymbolicConditionals")
-_CLASSES: dict[str, type] = {}
+#: variant → the wavefront BSDF class (one per variant)
+_CLASSES = bounded_cache("brdfkit.render.mitsuba_wavefront._CLASSES", maxsize=len(VARIANTS))
 
 
 @contextlib.contextmanager

@@ -42,13 +42,12 @@ References
 from __future__ import annotations
 
 import math
-from collections import OrderedDict
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numba
 import numpy as np
 
+from brdfkit._cache import bounded_cache, memo
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models import BRDF
 from brdfkit.render.ambient import RHO_TOL, ambient_table
@@ -201,7 +200,7 @@ def _scatter(out, index, weight, f):  # pragma: no cover - compiled
             out[index[k], ch] += weight[k] * f[k, ch]
 
 
-@lru_cache(maxsize=16)
+@memo(maxsize=16)  # one float per image size
 def _max_r2(size: int) -> float:
     """Largest x² + y² of a pixel centre inside the disc (the outermost pixel)."""
     c, mask = _disc(size)
@@ -212,8 +211,7 @@ def _max_r2(size: int) -> float:
 #: The last few ρ(θ_V) images, keyed by (id(table), S): the ambient image does not depend
 #: on Φ_L or E, so a series of renders of one model reuses it (each entry keeps its table
 #: alive, so an id is never reused while its entry exists). 4 entries: ≤ 25 MB at 512², RGB.
-_RHO_IMAGES: OrderedDict = OrderedDict()
-_RHO_IMAGES_MAX = 4
+_RHO_IMAGES = bounded_cache("brdfkit.render.sphere._RHO_IMAGES", maxsize=4)
 
 
 def _rho_image(table, S: int, C: int) -> np.ndarray:
@@ -221,7 +219,6 @@ def _rho_image(table, S: int, C: int) -> np.ndarray:
     key = (id(table), S)
     hit = _RHO_IMAGES.get(key)
     if hit is not None and hit[0] is table:
-        _RHO_IMAGES.move_to_end(key)
         return hit[1]
     # ρ(θ_V) is the same at (±x, ±y): evaluate one quadrant (the first h rows and columns,
     # h = ⌈S/2⌉) and mirror it; N_z = √(1 − x² − y²) = cos θ_V
@@ -238,8 +235,6 @@ def _rho_image(table, S: int, C: int) -> np.ndarray:
     image = np.concatenate([top, top[: S - h][::-1]], axis=0).reshape(S * S, C)
     image.flags.writeable = False
     _RHO_IMAGES[key] = (table, image)
-    if len(_RHO_IMAGES) > _RHO_IMAGES_MAX:
-        _RHO_IMAGES.popitem(last=False)
     return image
 
 
