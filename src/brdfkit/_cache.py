@@ -140,9 +140,17 @@ class BoundedCache:
         return value
 
     def __getitem__(self, key):
-        value = self.get(key, _MISSING)
+        k = weakref.ref(key) if self.weak else key
+        data = self._data
+        value = data.get(k, _MISSING)
         if value is _MISSING:
+            self.misses += 1
             raise KeyError(key)
+        try:
+            data.move_to_end(k)
+        except KeyError:  # evicted by another thread meanwhile: still a valid value
+            pass
+        self.hits += 1
         return value
 
     def __setitem__(self, key, value) -> None:
@@ -158,7 +166,7 @@ class BoundedCache:
             del self._data[self._key(key)]
 
     def __contains__(self, key) -> bool:
-        return self._key(key) in self._data
+        return (weakref.ref(key) if self.weak else key) in self._data
 
     def __len__(self) -> int:
         return len(self._data)

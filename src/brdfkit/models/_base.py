@@ -39,11 +39,11 @@ import math
 from collections.abc import Callable
 from typing import ClassVar
 
-import numba
 import numpy as np
 
 from brdfkit._array import as_directions, as_uniform
 from brdfkit._dual import Formulas
+from brdfkit._threads import numba_threads
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models._drivers import (  # noqa: F401  (re-exported: models import them here)
     SERIAL_BELOW,
@@ -382,10 +382,8 @@ class BRDF:
         wo2 = np.ascontiguousarray(wo).reshape(-1, 3)
         out = np.empty((wi2.shape[0], self._packed.shape[0]))
         driver = self._driver
-        threads = numba.get_num_threads()
-        if wi2.shape[0] < SERIAL_BELOW:
-            numba.set_num_threads(1)  # thread-local: only this call's parallel regions
-        try:
+        # fewer than SERIAL_BELOW pairs: one thread (waking the pool costs more than the work)
+        with numba_threads(1 if wi2.shape[0] < SERIAL_BELOW else None):
             if driver is not None:
                 n_bad = driver(wi2, wo2, self._driver_data(), out)
             else:
@@ -394,8 +392,6 @@ class BRDF:
                 cached = cached_driver(self.kernel)
                 n_bad = (cached(wi2, wo2, self._packed, out) if cached is not None
                          else eval_pairs_checked(self.kernel, wi2, wo2, self._packed, out))
-        finally:
-            numba.set_num_threads(threads)
         if n_bad:
             as_directions(wi_in, "wi")  # raises the usual BrdfkitError for NaN/inf
             as_directions(wo_in, "wo")
