@@ -152,10 +152,10 @@ class AmbientTable:
     status : int
         ``brdfkit.status.STATUS["render"]``: converged (0: the goal was met and every
         engine angle converged) or limit (1: the error estimate is above the goal).
-    message : str
-        One line: what was reached, or why not.
-    success : bool
-        The status's success.
+    detail : str
+        One line: what was reached, or why not, with the numbers.
+    success, message : bool, str
+        The status's success; its message followed by ``detail``.
     """
 
     theta: np.ndarray
@@ -163,11 +163,15 @@ class AmbientTable:
     error: float
     tol: float
     status: int
-    message: str
+    detail: str
 
     @property
     def success(self) -> bool:
         return STATUS["render"].success(self.status)
+
+    @property
+    def message(self) -> str:
+        return f"{STATUS['render'].message(self.status)}: {self.detail}"
 
     def __post_init__(self):
         object.__setattr__(self, "_interp", _spline(self.theta, self.rho))
@@ -295,4 +299,4 @@ def _build(target: BRDF, th_max: float, goal: float) -> AmbientTable:
                    f"error estimate {error:.2g}")
     codes = STATUS["render"]
     return AmbientTable(theta=theta, rho=rho, error=error, tol=goal,
-                        status=codes.CONVERGED if met else codes.LIMIT, message=message)
+                        status=codes.CONVERGED if met else codes.LIMIT, detail=message)

@@ -426,7 +426,7 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
         theta_max = max(math.acos(math.sqrt(max(1.0 - _max_r2(S), 0.0))), 1e-3)
         table = ambient_table(model, theta_max=theta_max, tol=rho_tol)
         out = L_a * _rho_image(table, S, C)
-        err, msg, ok = L_a * table.error, table.message, table.success
+        err, msg, ok = L_a * table.error, table.detail, table.success
     else:
         out = np.zeros((S * S, C))
     if E > 0.0 and model.kernel is not None:
