@@ -21,10 +21,11 @@ LAYER = {
     "errors": 0, "_array": 0, "_kern": 0, "geometry": 0, "fresnel": 0, "halfangle": 0,
     "tables": 0, "_io": 0, "_dual": 0, "status": 0,
     # the package root is the public facade (brdfkit.model resolves model names and
-    # material specs): layer 2, so the data layer is below it and cli/figures above
-    "": 2, "_specs": 2, "models": 1,
-    "analysis": 2, "data": 2,
-    "pumping": 3, "fitting": 3, "render": 3,
+    # material specs; brdfkit.spec builds a ModelSpec, applying its operators): layer 2,
+    # so the data layer and the operators (pumping) are beside it and cli/figures above
+    "": 2, "spec": 2, "models": 1,
+    "analysis": 2, "data": 2, "pumping": 2,
+    "fitting": 3, "render": 3,
     "figures": 4, "cli": 4, "report": 4, "explorer": 4, "__main__": 4,
 }
 MAX_LINES = 850

@@ -567,17 +567,9 @@ def mirror_radiance(model, theta) -> np.ndarray:
 
 
 def from_dict(d: dict) -> BRDF:
-    """Rebuild a model from :meth:`BRDF.to_dict` / :meth:`PumpedBRDF.to_dict` output."""
-    from brdfkit.models import model as make
+    """Rebuild a model from :meth:`BRDF.to_dict` / :meth:`PumpedBRDF.to_dict` output —
+    a registered model or a material (``merl:…``), pumped or not — through
+    :class:`brdfkit.spec.ModelSpec`."""
+    from brdfkit.spec import ModelSpec
 
-    if not isinstance(d, dict) or "model" not in d:
-        raise ParameterError(f"from_dict: expected a dict with a 'model' key; got {d!r}")
-    m = make(d["model"], **d.get("params", {}))
-    chain = d.get("pump")
-    if chain is None:
-        return m
-    for stage in ([chain] if isinstance(chain, dict) else chain):
-        if stage.get("g") == "custom":
-            raise ParameterError("from_dict: a custom g cannot be rebuilt from a dict")
-        m = pump(m, stage.get("g", "max"), times=int(stage.get("times", 1)))
-    return m
+    return ModelSpec.from_dict(d).build()

@@ -79,8 +79,9 @@ Public objects
   …}``: ``SPEC`` a model name or material spec (``brdfkit.model(spec,
   **params)``), per-channel values as comma-separated strings
   (``"eta": "0.2, 0.9, 1.1"``), optional ``"wavelengths": "450, 550, 650"``
-  (nm; the channels' wavelengths), ``"pump": N`` (pump N times) and
-  ``"pump_g": "max"|"controlled"``.
+  (nm; the channels' wavelengths), ``"pump": "max"|"controlled"`` and
+  ``"times": K`` — the flat form of :class:`brdfkit.spec.ModelSpec`; the old
+  ``"pump": N`` (pump N times) with ``"pump_g"`` is still read.
 
 References
 ----------
@@ -97,7 +98,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from brdfkit._specs import model as build_model
+from brdfkit.spec import model as build_model
 from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
 from brdfkit.render.mitsuba_colour import ColourMap, check_wavelengths

@@ -54,6 +54,7 @@ def fig1_figure(study, path, theta_i=(30.0, 60.0)):
     from matplotlib.ticker import NullFormatter
 
     import brdfkit
+    from brdfkit.spec import ModelSpec
 
     l1 = _by_target(study.get(("nielsen", "alpha-mix-l1"), []))
     l2 = _by_target(study.get(("nielsen", "alpha-mix-l2"), []))
@@ -65,8 +66,8 @@ def fig1_figure(study, path, theta_i=(30.0, 60.0)):
                              layout="constrained")
     for j, t in enumerate(mats):
         target = brdfkit.data.material(t)
-        m1 = brdfkit.model("nielsen", **_params(l1[t]))
-        m2 = brdfkit.model("nielsen", **_params(l2[t]))
+        m1, m2 = (ModelSpec.from_dict({"model": "nielsen", "params": _params(r[t])}).build()
+                  for r in (l1, l2))
         for i, ti in enumerate(theta_i):
             ax = axes[i, j]
             y = in_plane_slice(target, ti, th)
