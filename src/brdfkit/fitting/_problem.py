@@ -249,6 +249,3 @@ class Problem:
                                         w_sum=self._w_solve_sum)
         self._warm = P.copy()
         return P, value
-
-    # the name of evaluate before (scripts read it)
-    _values = evaluate
