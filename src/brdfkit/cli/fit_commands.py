@@ -21,6 +21,7 @@ import brdfkit.cli._progress as _progress
 from brdfkit.cli._common import PARAM_HELP, emit_json
 from brdfkit.errors import BrdfkitError
 from brdfkit.spec import ModelSpec, canonical_name, parse_items
+from brdfkit.fitting import LOSSES, PROCEDURES  # the registries' names (--loss, --procedure)
 
 __all__ = ["fit_cmd"]
 
@@ -40,9 +41,9 @@ __all__ = ["fit_cmd"]
               help="The material(s) to fit (repeatable): merl:NAME[@nbrdf|npf|abc|sgd], "
                    "rgl:NAME, nielsen:NAME, a MERL .binary path, or merl:all, rgl:all, "
                    "nielsen:all (every built-in material of the source).")
-@click.option("--loss", type=click.Choice(["l1", "l2", "ngan", "log", "perceptual"]),
+@click.option("--loss", type=click.Choice(list(LOSSES)),
               default="l1", show_default=True, help="The loss minimised (docs/fitting.md).")
-@click.option("--procedure", type=click.Choice(["auto", "staged", "nielsen", "direct"]),
+@click.option("--procedure", type=click.Choice(list(PROCEDURES)),
               default="auto", show_default=True, help="The fitting procedure.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of random starts.")
 @click.option("--starts", type=click.IntRange(min=1), default=3, show_default=True,

@@ -277,11 +277,11 @@ def relative_errors(model, target) -> tuple[float, float]:
 
     C = int(target.n_channels or 1)
     prob = Problem(model, target, merl_samples(), "perceptual", C)
-    m = prob._values(model, prob.samples.wi, prob.samples.wo) * prob.cos
+    m = prob.evaluate(model, prob.samples.wi, prob.samples.wo) * prob.cos
     tau = TAU_REL * (prob.w @ prob.y) / np.sum(prob.w)
     e_point = float(np.max(np.abs(np.log((np.maximum(m, 0.0) + tau) / (prob.y + tau)))))
     wi, wo, wa, T = prob._anodes
-    a_m = albedo_from_values(prob._values(model, wi, wo), wa, T)
+    a_m = albedo_from_values(prob.evaluate(model, wi, wo), wa, T)
     tiny = 1e-12  # as the loss: an albedo of exactly 0 has an infinite log ratio
     e_albedo = float(np.max(np.abs(np.log(np.maximum(a_m, tiny)
                                           / np.maximum(prob.albedo_t, tiny)))))
@@ -378,7 +378,7 @@ def ngan_metric(model, target) -> float:
     from brdfkit.fitting.samples import merl_samples
 
     prob = Problem(model, target, merl_samples(), "ngan", int(target.n_channels or 1))
-    pred = prob._values(model, prob.samples.wi, prob.samples.wo) * prob.cos
+    pred = prob.evaluate(model, prob.samples.wi, prob.samples.wo) * prob.cos
     return prob.loss_of(model, pred)
 
 

@@ -115,6 +115,11 @@ class PumpedBRDF(DerivedBRDF):
         albedo; empty for a custom g (evaluated in NumPy from ``table``).
     """
 
+    @property
+    def fit_base(self) -> BRDF:
+        """A fit starts from the unpumped root's fit (``BRDF.fit_base``)."""
+        return self.root
+
     def __init__(self, base: BRDF, g: str | Callable = "max"):
         self.base = base
         self.root = base.root if isinstance(base, PumpedBRDF) else base

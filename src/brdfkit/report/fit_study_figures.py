@@ -31,12 +31,12 @@ def alpha_figure(study, path):
 
     fig, ax = plt.subplots(figsize=(6.0, 3.4), layout="constrained")
     bins = np.linspace(0.0, 1.0, 11)
-    for loss, colour in (("l1", "C0"), ("l2", "C1")):
+    for loss, colour, histtype, opacity in (("l1", "C0", "stepfilled", 0.5),
+                                            ("l2", "C1", "step", 1.0)):
         a = [_params(r).get("alpha") for r in study.get(("nielsen", f"alpha-mix-{loss}"), [])
              if _ok(r)]
         a = [x for x in a if x is not None]
-        ax.hist(a, bins=bins, histtype="step" if loss == "l2" else "stepfilled",
-                alpha=1.0 if loss == "l2" else 0.5, color=colour, lw=1.5,
+        ax.hist(a, bins=bins, histtype=histtype, alpha=opacity, color=colour, lw=1.5,
                 label=f"{loss.upper()} fits ({len(a)})")
     from matplotlib.ticker import MaxNLocator
 
