@@ -33,7 +33,7 @@ import warnings
 
 import brdfkit
 import brdfkit.fitting._problem as problem_mod
-import brdfkit.fitting.procedure as procedure_mod
+import brdfkit.fitting._run as run_mod
 import brdfkit.pumping.surrogate as surrogate_mod
 from brdfkit.fitting import fit
 from brdfkit.fitting.samples import merl_samples
@@ -55,16 +55,16 @@ def _timed(fn, key):
 def run(model, target, loss, *, fast: bool):
     """(seconds, FitResult, build seconds, eval seconds) of one fit."""
     surrogate_mod._NODE_CACHE.clear()
-    saved = procedure_mod.surrogate
+    saved = run_mod.surrogate
     if not fast:
-        procedure_mod.surrogate = lambda *a, **k: None
+        run_mod.surrogate = lambda *a, **k: None
     _SPLIT.update(build=0.0, eval=0.0)
     try:
         t = time.perf_counter()
         r = fit(model, target, loss=loss)
         return time.perf_counter() - t, r, _SPLIT["build"], _SPLIT["eval"]
     finally:
-        procedure_mod.surrogate = saved
+        run_mod.surrogate = saved
 
 
 def main():
@@ -77,7 +77,7 @@ def main():
     ap.add_argument("--no-baseline", action="store_true")
     a = ap.parse_args()
     problem_mod.Problem.build = _timed(problem_mod.Problem.build, "build")
-    problem_mod.Problem._values = _timed(problem_mod.Problem._values, "eval")
+    problem_mod.Problem.evaluate = _timed(problem_mod.Problem.evaluate, "eval")
     model = pump(brdfkit.model("modified-phong"))
     s = merl_samples()
     with warnings.catch_warnings():  # warm-up: the capped and uncapped kernels compiled

@@ -19,6 +19,7 @@ import time
 
 import brdfkit
 from brdfkit.fitting import fit
+from brdfkit.spec import ModelSpec
 
 MATERIALS = ("two-layer-silver", "nickel", "violet-rubber", "red-fabric2",
              "gold-metallic-paint", "white-diffuse-bball", "black-obsidian")
@@ -28,12 +29,13 @@ MODELS = ("modified-phong", "modified-blinn-phong", "nielsen", "lafortune", "war
 
 
 def build(name):
-    kw = {}
+    """A model word of MODELS (``NAME[-DISTRIBUTION][+eta]``) as a spec, built."""
+    words = []
     if name.endswith("+eta"):
-        name, kw = name[:-4], {"eta": 1.5}
+        name, words = name[:-4], ["eta=1.5"]
     if name.startswith("microfacet-"):
-        return brdfkit.model("microfacet", distribution=name.split("-")[1], **kw)
-    return brdfkit.model(name, **kw)
+        name, words = "microfacet", [f"distribution={name.split('-')[1]}", *words]
+    return ModelSpec.parse(name, words).build()
 
 
 def main():

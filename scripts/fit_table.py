@@ -15,7 +15,7 @@ import numpy as np
 
 import brdfkit
 from brdfkit.fitting import fit
-from brdfkit.pumping import pump
+from brdfkit.spec import ModelSpec
 
 MATERIALS = ("merl:nickel", "merl:violet-rubber", "merl:two-layer-silver", "merl:red-fabric2",
              "merl:gold-metallic-paint")
@@ -23,12 +23,15 @@ MODELS = ("modified-phong", "modified-blinn-phong", "nielsen", "lafortune", "war
           "cook-torrance", "microfacet-beckmann", "microfacet-ggx", "pumped-modified-phong")
 
 
+#: The table's model words → the spec of each (brdfkit.spec.ModelSpec, command-line words).
+SPECS = {"pumped-modified-phong": ("modified-phong", (), "max"),
+         "microfacet-beckmann": ("microfacet", ("distribution=beckmann",), None),
+         "microfacet-ggx": ("microfacet", ("distribution=ggx",), None)}
+
+
 def build(name):
-    if name == "pumped-modified-phong":
-        return pump(brdfkit.model("modified-phong"), times=1)
-    if name.startswith("microfacet-"):
-        return brdfkit.model("microfacet", distribution=name.split("-")[1])
-    return brdfkit.model(name)
+    target, params, g = SPECS.get(name, (name, (), None))
+    return ModelSpec.parse(target, params, pump=g).build()
 
 
 def main():

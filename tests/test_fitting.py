@@ -211,3 +211,47 @@ def test_solve_channels_matches_the_single_channel_solve_and_its_loss(K):
                                       rel=1e-12)
     B[0, 3, 1] = np.nan  # a non-finite basis value: the loss is inf, not NaN
     assert solve_channels(B, R, w, lo, hi, True, 3, np.empty((0, 0)))[1] == math.inf
+
+
+def test_albedo_error_estimate_bounds_the_true_error():
+    # References: closed forms and a second method. Lambertian: a(θ) = ρ at every θ.
+    # Modified Phong (f = ρ_d/π + ρ_s (n + 2)/(2π) cosⁿα, α the angle to the mirror
+    # direction): at normal incidence the mirror is the normal, ∫ cosⁿθ cos θ dω = 2π/(n + 2),
+    # so a(0) = ρ_d + ρ_s; at the other angles the albedo engine (error ≤ 1e-9, stated).
+    from brdfkit.analysis import albedo
+    from brdfkit.fitting.samples import ALBEDO_THETA_DEG, albedo_with_error
+
+    wi, wo, w, T = albedo_nodes(ALBEDO_THETA_DEG)
+    rho = np.array([0.2, 0.5, 0.9])
+    f = np.asarray(brdfkit.model("lambert", rho_d=rho).eval(wi, wo)).reshape(len(w), -1)
+    a, err = albedo_with_error(f, w, T, 48, 24)
+    assert err.shape == a.shape == (T, 3)
+    assert np.all(np.abs(a - rho) <= err)
+    assert err.max() <= 2e-2 * rho.max()  # and not vacuous: a small fraction of a
+    for n in (1.0, 20.0, 300.0):
+        m = brdfkit.model("modified-phong", rho_d=0.2, rho_s=0.6, n=n)
+        f = np.asarray(m.eval(wi, wo)).reshape(len(w), -1)
+        a, err = albedo_with_error(f, w, T, 48, 24)
+        assert abs(a[0, 0] - 0.8) <= err[0, 0], n
+        ref = albedo(m, np.radians(ALBEDO_THETA_DEG), tol=1e-9)
+        assert np.max(ref.error) <= 1e-8
+        assert np.all(np.abs(a[:, 0] - np.ravel(ref.albedo)) <= err[:, 0]), n
+        assert err.max() <= 0.05 * 0.8  # not vacuous (a sharp lobe: the largest, n = 300)
+    with pytest.raises(ParameterError, match="multiples of 3"):
+        albedo_with_error(f, w, T, 48, 25)
+
+
+def test_fit_result_albedos_carry_their_error():
+    # A Lambertian fitted to a Lambertian: both albedo curves are the fitted and the
+    # target's ρ (closed form), within the reported error estimates; the JSON carries them
+    # after the albedo keys it always had.
+    target = brdfkit.model("lambert", rho_d=[0.3, 0.5, 0.7])
+    r = fit(brdfkit.model("lambert"), target, loss="l2")
+    rho_fit = np.asarray(r.params["rho_d"])
+    assert rho_fit == pytest.approx([0.3, 0.5, 0.7], rel=1e-9)
+    assert np.all(np.abs(r.albedo_model - rho_fit) <= r.albedo_model_error)
+    assert np.all(np.abs(r.albedo_target - np.array([0.3, 0.5, 0.7])) <= r.albedo_target_error)
+    d = r.to_dict()["albedo"]
+    assert list(d) == ["theta_deg", "model", "target", "rel_error", "model_error",
+                       "target_error"]
+    assert np.asarray(d["model_error"]).shape == r.albedo_model.shape

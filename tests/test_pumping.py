@@ -458,7 +458,7 @@ def test_paper_observations_n20(phong_max, blinn_ctrl):
     increase with the second" (module docstring has the numbers)."""
     from brdfkit.analysis import hemispherical_albedo
 
-    r_p = [float(hemispherical_albedo(m, n=24)[0]) for m in phong_max]
+    r_p = [float(hemispherical_albedo(m, n=24).value) for m in phong_max]
     # The thresholds are a stated criterion, not values read off this code: a pumping
     # "is worth it" when it adds >= 5 % of the incident energy to rho_hh, and adds
     # "not significantly" when < 2 %. "Worth pumping 2 or 3 times" = the first two
@@ -468,7 +468,7 @@ def test_paper_observations_n20(phong_max, blinn_ctrl):
     assert gain_p[0] > worth and gain_p[1] > worth
     assert gain_p[2] < insignificant and gain_p[3] < insignificant
     assert np.all(np.diff(gain_p) < 0.0)
-    r_b = [float(hemispherical_albedo(m, n=24)[0]) for m in blinn_ctrl]
+    r_b = [float(hemispherical_albedo(m, n=24).value) for m in blinn_ctrl]
     gain_b = np.diff(r_b)
     # the paper: "does not significantly increase with the second and consecutive" pumpings;
     # computed: the second gains more than the first, and the second and third are worth it

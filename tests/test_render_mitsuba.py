@@ -609,3 +609,63 @@ def test_traced_microfacet_against_roughconductor_and_numba():
         np.testing.assert_allclose(got, want, rtol=1e-4, atol=1e-6 * want.max())
         del ours
     gc.collect()
+
+
+def test_stated_monte_carlo_error_is_the_deviation_from_the_exact_render():
+    """SphereRender.mc_error (the per-pixel standard error of K independent passes) against
+    the deviation of the Monte-Carlo image from the exact render of the same configuration.
+
+    Reference (a second method): the direct engine on an 8× finer grid, averaged over each
+    pixel's 8×8 sub-pixel centres — the pixel-area average the Monte-Carlo pixel estimates
+    (box filter), to O((pixel/8)²). Over the pixels whose square lies inside the disc,
+    z = (MC − exact)/mc_error is Student-t with K − 1 = 15 degrees of freedom (variance
+    15/13 = 1.154; |z| > t_0.975 = 2.131 for 5 % of the pixels). Power: an error stated
+    twice too large or too small, or the per-sample spread instead of the error of the
+    mean, is rejected by the same bounds."""
+    from brdfkit.render import render_sphere
+
+    variant = _variant("llvm_ad_rgb")
+    if variant.startswith("scalar"):
+        pytest.skip("needs an llvm variant (128 spp)")
+    model = brdfkit.model("modified-phong", rho_d=0.2, rho_s=0.5, n=20.0)
+    size, sub, spp, k = 24, 8, 128, 16
+    kw = {"phi_l": math.radians(30.0), "ambient": 0.3, "irradiance": 1.0}
+    mc = render_sphere(model, size=size, engine="mitsuba", spp=spp, passes=k, seed=3, **kw)
+    assert mc.status == 0 and mc.success and mc.passes == k
+    assert mc.mc_error.shape == mc.radiance.shape
+    exact = render_sphere(model, size=size * sub, **kw).radiance
+    exact = exact.reshape(size, sub, size, sub, -1).mean(axis=(1, 3))
+    c = (np.arange(size) + 0.5) / size * 2.0 - 1.0
+    cx, cy = np.meshgrid(c, -c)
+    inside = np.hypot(np.abs(cx) + 1.0 / size, np.abs(cy) + 1.0 / size) < 1.0
+    dev = (mc.radiance - exact)[inside][:, 0]  # grey model: the channels are equal
+    se = mc.mc_error[inside][:, 0]
+    assert np.all(se > 0.0)
+    t975 = stats.t.ppf(0.975, k - 1)
+
+    def consistent(z):
+        return 0.75 < np.var(z) < 1.75 and 0.01 < np.mean(np.abs(z) > t975) < 0.10 \
+            and abs(np.mean(z)) < 0.25
+
+    assert consistent(dev / se), (np.var(dev / se), np.mean(np.abs(dev / se) > t975))
+    for wrong in (2.0 * se, 0.5 * se, se * math.sqrt(spp)):
+        assert not consistent(dev / wrong)
+
+
+def test_one_pass_states_no_error_and_keeps_the_single_render():
+    """passes=1: the image is render_sphere_mitsuba's for the same seed, bit for bit; no
+    standard error can be estimated, and the status says so (undetermined)."""
+    from brdfkit.render import render_sphere
+    from brdfkit.status import STATUS
+
+    _variant("llvm_ad_rgb")
+    model = brdfkit.model("lambert", rho_d=0.5)
+    r = render_sphere(model, size=8, engine="mitsuba", spp=4, passes=1, seed=5, phi_l=0.3)
+    single = render_sphere_mitsuba(model, size=8, spp=4, seed=5, phi_l=0.3)
+    np.testing.assert_array_equal(r.radiance, single)
+    assert r.mc_error is None and r.status == STATUS["render"].UNDETERMINED
+    assert not r.success and STATUS["render"].message(r.status) in r.message
+    with pytest.raises(brdfkit.errors.ParameterError, match="passes must be"):
+        render_sphere(model, size=8, engine="mitsuba", spp=4, passes=5, phi_l=0.3)
+    with pytest.raises(brdfkit.errors.ParameterError, match="takes no samples"):
+        render_sphere(model, size=8, passes=2, phi_l=0.3)

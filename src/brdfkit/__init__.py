@@ -38,8 +38,10 @@ Public objects
 --------------
 - :func:`brdfkit.model` — build a registered model by name, or a measured
   material by its spec (``merl:nickel``, ``rgl:NAME``, ``nielsen:NAME``, a
-  ``.binary`` path): the one dispatcher (:mod:`brdfkit._specs`).
+  ``.binary`` path): the one dispatcher (:mod:`brdfkit.spec`).
 - :func:`brdfkit.model_params` — the parameter declarations a spec accepts.
+- :class:`brdfkit.ModelSpec` — what to build, its parameters and the operators
+  applied to it, from the command line's words or a dict (:mod:`brdfkit.spec`).
 - :func:`brdfkit.material` / :func:`brdfkit.materials` — the built-in
   measured materials (:mod:`brdfkit.data`).
 - :data:`brdfkit.MODELS` — the registry: canonical name → model class.
@@ -61,14 +63,15 @@ References
 """
 
 from brdfkit._cache import cache_info, clear_caches
-from brdfkit._specs import model, model_params
 from brdfkit.data import material, materials
 from brdfkit.errors import BrdfkitError, ParameterError, UnknownModelError
 from brdfkit.models import BRDF, MODELS, Param, model_names
+from brdfkit.spec import ModelSpec, model, model_params
 
 __all__ = [
     "BRDF",
     "MODELS",
+    "ModelSpec",
     "BrdfkitError",
     "Param",
     "ParameterError",

@@ -155,20 +155,24 @@ STATUS: dict[str, StatusCodes] = {
         _o(0, "converged", "the sampler follows its pdf (chi-squared test passed)", True),
         _o(1, "rejected", "chi-squared test rejected: the sampler does not follow its pdf",
            False),
-        _o(2, "limit", "the pdf's integral did not reach its tolerance in some cells",
-           False),
+        # success: the test passed; only the expected counts of a few cells are less exact
+        _o(2, "limit", "the chi-squared test passed, but the pdf's integral did not reach "
+                       "its tolerance in some cells", True),
         _o(3, "nonfinite", "the pdf or the samples are NaN or infinite", False),
     ]),
     "render": StatusCodes("render", [
         _o(0, "converged", "every term is within its stated error", True),
         _o(1, "limit", "a term did not reach its accuracy goal (its error estimate is "
                        "returned)", False),
+        _o(2, "undetermined", "one Monte-Carlo pass: no standard error can be estimated "
+                              "(render two or more passes)", False),
         _o(3, "nonfinite", "NaN or infinite radiance", False),
     ]),
     "hemispherical": StatusCodes("hemispherical", [
         _o(0, "converged", "converged: every directional albedo met its tolerance and the "
                            "outer rule's error estimate is stated", True),
-        _o(1, "limit", "a directional albedo did not converge (error estimate inf)", False),
+        _o(1, "limit", "a directional albedo did not converge (refinement limit or node "
+                       "cap; error estimate inf)", False),
         _o(3, "nonfinite", "a directional albedo is NaN", False),
     ]),
 }

@@ -8,9 +8,12 @@ Public objects
   with an error estimate and a status per angle (module
   :mod:`brdfkit.analysis.albedo_engine`; its compiled core is
   :mod:`brdfkit.analysis.quadrature`).
-- :func:`albedo_mc` — importance-sampled Monte-Carlo albedo.
-- :func:`hemispherical_albedo` — ρ_hh.
-- :func:`H_s` — Lewis's specular integral (§4.1, Fig. 5).
+- :func:`albedo_mc` — importance-sampled Monte-Carlo albedo, a second method
+  (:mod:`brdfkit.analysis.monte_carlo`).
+- :func:`hemispherical_albedo`, :class:`HemisphericalAlbedo` — ρ_hh over the engine
+  (:mod:`brdfkit.analysis.hemispherical`).
+- :func:`H_s` — Lewis's specular integral (§4.1, Fig. 5;
+  :mod:`brdfkit.analysis.specular_integral`).
 - :func:`check`, :class:`Verdict` — reciprocity and energy verdicts
   (:mod:`brdfkit.analysis.plausibility`).
 - :func:`table2` — Lewis's Table 2 regenerated for every registered model
@@ -22,15 +25,12 @@ References
 - [Neumann1999] §1.2, §2.1, Fig. 1.
 """
 
-from brdfkit.analysis.albedo_engine import (
-           AlbedoResult,
-           H_s,
-           albedo,
-           albedo_mc,
-           hemispherical_albedo,
-)
+from brdfkit.analysis.albedo_engine import AlbedoResult, albedo
+from brdfkit.analysis.hemispherical import HemisphericalAlbedo, hemispherical_albedo
+from brdfkit.analysis.monte_carlo import albedo_mc
+from brdfkit.analysis.specular_integral import H_s
 from brdfkit.analysis.lewis_table2 import table2
 from brdfkit.analysis.plausibility import Verdict, check
 
-__all__ = ["AlbedoResult", "H_s", "Verdict", "albedo", "albedo_mc", "check",
-           "hemispherical_albedo", "table2"]
+__all__ = ["AlbedoResult", "H_s", "HemisphericalAlbedo", "Verdict", "albedo", "albedo_mc",
+           "check", "hemispherical_albedo", "table2"]

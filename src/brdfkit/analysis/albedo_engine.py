@@ -35,13 +35,23 @@ the angle recomputed (up to 5 times).
 Isotropic models are integrated over φ ∈ [0, φ_max] and doubled (mirror
 symmetry about the plane of incidence); plain callables over both halves.
 
+This is brdfkit's one albedo engine: every directional albedo brdfkit reports comes
+from it. The other estimators are second methods beside it, each in its own module:
+:func:`~brdfkit.analysis.monte_carlo.albedo_mc` (importance-sampled Monte Carlo, a
+cross-check with a standard error), :func:`~brdfkit.analysis.hemispherical.
+hemispherical_albedo` (ρ_hh, an outer rule over this engine) and
+:func:`~brdfkit.analysis.specular_integral.H_s` (Lewis's H_s by its own 1-D quadrature).
+
 Public objects
 --------------
-- :class:`AlbedoResult` — θ_i, albedo, error estimate.
+- :class:`AlbedoResult` — θ_i, albedo, error estimate, status (``brdfkit.status``,
+  kind ``albedo``), ``success`` and ``message``.
 - :func:`albedo` — deterministic albedo of a model or callable.
-- :func:`albedo_mc` — importance-sampled Monte-Carlo estimate (cross-check).
-- :func:`hemispherical_albedo` — ρ_hh = (1/π) ∫ a(ω_i) cos θ_i dω_i.
-- :func:`H_s` — Lewis's specular integral H_s(S) (§4.1, Fig. 5).
+- :func:`evaluate_pairs`, :func:`check_theta`, :func:`lobe_frame` — shared with the
+  other estimators and the verdicts.
+- :data:`CONVERGED`, :data:`MAX_LEVEL_REACHED`, :data:`NODE_CAP`, :data:`NONFINITE`,
+  :data:`STATUS_MESSAGES` — the ``albedo`` codes of :data:`brdfkit.status.STATUS` and
+  their messages with this engine's numbers.
 
 References
 ----------
@@ -76,10 +86,10 @@ from brdfkit.analysis.quadrature import (  # the compiled core
 )
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models._base import BRDF
+from brdfkit.status import STATUS
 
-__all__ = ["AlbedoResult", "albedo", "albedo_mc", "hemispherical_albedo", "H_s", "lobe_frame",
+__all__ = ["AlbedoResult", "albedo", "evaluate_pairs", "check_theta", "lobe_frame",
            "STATUS_MESSAGES", "CONVERGED", "MAX_LEVEL_REACHED", "NODE_CAP", "NONFINITE"]
-
 
 
 # Not cached: a specialisation is keyed on the kernel's dispatcher, new in every
@@ -143,18 +153,19 @@ def evaluate_pairs(model, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
 MAX_CHUNK_NODES = 3_000_000
 MAX_ANGLE_NODES = 6_000_000
 
-#: Status of one angle of an :class:`AlbedoResult` (SciPy-style codes; see
-#: :data:`STATUS_MESSAGES`). Anything but CONVERGED means the error estimate is above the
-#: goal (``max(tol, 1e-10·|a|)``) or, for NONFINITE, that there is no estimate at all.
-CONVERGED, MAX_LEVEL_REACHED, NODE_CAP, NONFINITE = 0, 1, 2, 3
+#: Status of one angle of an :class:`AlbedoResult`: the ``albedo`` codes of
+#: :data:`brdfkit.status.STATUS` (kept as module names: tests and saved JSON use them).
+#: Anything but CONVERGED means the error estimate is above the goal
+#: (``max(tol, 1e-10·|a|)``) or, for NONFINITE, that there is no estimate at all.
+_CODES = STATUS["albedo"]
+CONVERGED, MAX_LEVEL_REACHED, NODE_CAP, NONFINITE = (
+    _CODES.CONVERGED, _CODES.LIMIT, _CODES.NODE_CAP, _CODES.NONFINITE)
+#: code → message: the status table's message with this engine's numbers.
 STATUS_MESSAGES = {
-    CONVERGED: "converged: the error estimate meets the tolerance",
-    MAX_LEVEL_REACHED: f"tolerance not reached after {MAX_LEVEL} refinements (the error "
-                       "estimate is returned; a sharper lobe or a kink the model does not "
-                       "declare)",
-    NODE_CAP: f"tolerance not reached: the next refinement needs more than "
-              f"{MAX_ANGLE_NODES:,} nodes (the error estimate is returned)",
-    NONFINITE: "the integrand is NaN or infinite at some quadrature nodes (albedo NaN)",
+    CONVERGED: _CODES.message(CONVERGED),
+    MAX_LEVEL_REACHED: f"{_CODES.message(MAX_LEVEL_REACHED)}; {MAX_LEVEL} refinements",
+    NODE_CAP: f"{_CODES.message(NODE_CAP)}; bound: {MAX_ANGLE_NODES:,} nodes per angle",
+    NONFINITE: _CODES.message(NONFINITE),
 }
 
 
@@ -261,8 +272,11 @@ class AlbedoResult:
         Error estimate (absolute), same shape as ``albedo``.
     status : ndarray of int8, shape ``theta.shape``
         Per angle: :data:`CONVERGED` (0), :data:`MAX_LEVEL_REACHED` (1),
-        :data:`NODE_CAP` (2) or :data:`NONFINITE` (3); :data:`STATUS_MESSAGES`
-        says what each means. Only CONVERGED angles meet the tolerance.
+        :data:`NODE_CAP` (2) or :data:`NONFINITE` (3) — ``brdfkit.status.STATUS["albedo"]``;
+        :data:`STATUS_MESSAGES` says what each means. Only CONVERGED angles meet the
+        tolerance.
+    success, message
+        Whether every angle converged; one line saying which did not and why.
     """
 
     theta: np.ndarray
@@ -278,7 +292,7 @@ class AlbedoResult:
     @property
     def success(self) -> bool:
         """True when every angle converged to the tolerance."""
-        return bool(np.all(self.status == CONVERGED))
+        return bool(np.all([_CODES.success(c) for c in np.unique(self.status)]))
 
     @property
     def message(self) -> str:
@@ -508,186 +522,3 @@ def _callable_evaluator(f: Callable, what: str):
     evaluate.coloured = False
     probe, _ = evaluate(np.array([0.0]), np.array([0, 1]), np.array([[0.0, 0.0, 1.0]]))
     return evaluate, probe.shape[1]
-
-
-# --------------------------------------------------------------------------- Monte Carlo
-def _check_rng(rng) -> np.random.Generator:
-    if isinstance(rng, np.random.Generator):
-        return rng
-    if rng is None or (isinstance(rng, int | np.integer) and not isinstance(rng, bool)
-                       and rng >= 0):
-        return np.random.default_rng(rng)
-    raise ParameterError(f"rng must be a seed (an integer >= 0), a numpy.random.Generator "
-                         f"or None; got {type(rng).__name__} {rng!r}")
-
-
-def albedo_mc(model, theta_i, *, n_samples: int = 100_000, rng=None,
-              defensive: float = 0.1) -> AlbedoResult:
-    """Importance-sampled Monte-Carlo albedo with its standard error.
-
-    Directions are drawn from the mixture (1 − δ)·model.sample(·| ω_i) + δ·cos θ/π
-    (δ = ``defensive``; the cosine part keeps the estimator unbiased where the
-    model's sampler misses part of the support), and the estimator is
-    f(ω_i, ω) cos θ / pdf_mix(ω). Callables use cosine sampling only.
-
-    Parameters
-    ----------
-    model : BRDF or callable
-    theta_i : float or array_like
-        Radians in [0, π/2).
-    n_samples : int, keyword-only
-        Samples per angle (≥ 2).
-    rng : int or numpy.random.Generator, keyword-only
-        Seed or generator (required for reproducibility; None draws fresh entropy).
-    defensive : float, keyword-only
-        Weight of the cosine component in (0, 1].
-
-    Returns
-    -------
-    AlbedoResult
-        ``error`` is the standard error of the mean (1σ); status NONFINITE
-        (albedo NaN) where a sample's value was NaN or infinite.
-    """
-    from brdfkit.geometry import pdf_cosine_hemisphere, sample_cosine_hemisphere
-
-    _check_model(model, "albedo_mc")
-    th = check_theta(theta_i)
-    if isinstance(n_samples, bool) or not isinstance(n_samples, int | np.integer) \
-            or n_samples < 2:
-        raise ParameterError(f"n_samples must be an integer >= 2; got {n_samples!r}")
-    n_samples = int(n_samples)
-    try:
-        defensive = float(defensive)
-    except (TypeError, ValueError):
-        defensive = float("nan")
-    if not (0.0 < defensive <= 1.0):
-        raise ParameterError(f"defensive must lie in (0, 1]; got {defensive!r}")
-    gen = _check_rng(rng)
-    has_sampler = isinstance(model, BRDF) and model.has_sampler
-    if not has_sampler:
-        defensive = 1.0
-    vals_a, vals_e, status = [], [], []
-    for theta in th.reshape(-1):
-        wi = np.array([math.sin(theta), 0.0, math.cos(theta)])
-        u = gen.random((n_samples, 2))
-        pick = gen.random(n_samples) < defensive
-        w = sample_cosine_hemisphere(u)
-        if has_sampler:
-            ws, _ = model.sample(np.broadcast_to(wi, (n_samples, 3)), u)
-            w = np.where(pick[:, None], w, ws)
-        wib = np.broadcast_to(wi, w.shape)
-        pdf = defensive * pdf_cosine_hemisphere(w)
-        if has_sampler:
-            pdf = pdf + (1.0 - defensive) * model.pdf(w, wib)
-        up = (w[:, 2] > 0.0) & (pdf > 0.0)
-        w_safe = np.where(up[:, None], w, np.array([0.0, 0.0, 1.0]))
-        f = evaluate_pairs(model, wib, w_safe)
-        est = np.where(up[:, None], f * (w_safe[:, 2] / np.where(up, pdf, 1.0))[:, None], 0.0)
-        ok = bool(np.all(np.isfinite(est)))
-        vals_a.append(est.mean(axis=0) if ok else np.full(est.shape[1], np.nan))
-        vals_e.append(est.std(axis=0, ddof=1) / math.sqrt(n_samples) if ok
-                      else np.full(est.shape[1], np.inf))
-        status.append(CONVERGED if ok else NONFINITE)
-    a = np.array(vals_a)
-    e = np.array(vals_e)
-    extra = model.specular_albedo(th.reshape(-1)) if isinstance(model, BRDF) else None
-    if extra is not None:
-        a = a + np.asarray(extra, dtype=np.float64).reshape(a.shape[0], -1)
-    status = np.array(status, dtype=np.int8).reshape(th.shape)
-    coloured = model.n_channels is not None if isinstance(model, BRDF) else a.shape[1] > 1
-    if not coloured and a.shape[1] == 1:
-        return AlbedoResult(th.copy(), a[:, 0].reshape(th.shape), e[:, 0].reshape(th.shape),
-                            status)
-    return AlbedoResult(th.copy(), a.reshape(th.shape + (-1,)), e.reshape(th.shape + (-1,)),
-                        status)
-
-
-# --------------------------------------------------------------------------- ρ_hh and H_s
-def hemispherical_albedo(model, *, n: int = 48, tol: float = 1e-7) -> tuple[np.ndarray,
-                                                                           np.ndarray]:
-    """Hemispherical–hemispherical albedo ρ_hh = (1/π) ∫ a(ω_i) cos θ_i dω_i.
-
-    With μ = cos θ_i = u², ρ_hh = ∫₀¹ a(μ) 2μ dμ = ∫₀¹ 4 a(u²) u³ du, computed with
-    n-point Gauss–Legendre in u (smooth even when a ∝ μ^−p near grazing), and the
-    n/2-point rule for the error estimate.
-
-    Returns
-    -------
-    (value, error) : ndarrays, scalars or (C,) for coloured models. The error is
-        infinite when an albedo did not converge (see :attr:`AlbedoResult.status`).
-    """
-    _check_model(model, "hemispherical_albedo")
-    if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 2 <= n <= 1000:
-        # the n/2-point rule gives the error estimate, so n >= 2; 1000 nodes: far beyond the
-        # accuracy of the albedo itself (a is smooth in u = sqrt(cos theta_i))
-        raise ParameterError(f"hemispherical_albedo: n must be an integer in [2, 1000]; "
-                             f"got {n!r}")
-    x, w = np.polynomial.legendre.leggauss(int(n))
-    x2, w2 = np.polynomial.legendre.leggauss(int(n) // 2)
-    us = np.concatenate([(x + 1) / 2, (x2 + 1) / 2])
-    th = np.arccos(np.clip(us * us, 0.0, 1.0))
-    th = np.minimum(th, math.pi / 2 - 1e-12)  # the node nearest grazing stays inside [0, π/2)
-    r = albedo(model, th, tol=tol)
-    a = np.asarray(r.albedo)
-    wt = 4.0 * us ** 3
-    wt = wt.reshape(wt.shape + (1,) * (a.ndim - 1))
-    aw = a * wt
-    v1 = np.tensordot(w / 2, aw[: len(x)], axes=(0, 0))
-    v2 = np.tensordot(w2 / 2, aw[len(x):], axes=(0, 0))
-    ew = np.asarray(r.error)[: len(x)] * wt[: len(x)]
-    err = np.abs(v1 - v2) + np.tensordot(w / 2, ew, axes=(0, 0))
-    if not r.success:  # an unconverged angle's estimate is not a bound
-        err = np.full_like(err, np.inf)
-    return v1, err
-
-
-def H_s(theta_i, n: float, *, lobe: str = "phong", tol: float = 1e-8) -> AlbedoResult:
-    """Lewis's specular integral H_s(S) = ∫ F_s(S, V) (N·V) dω_V (§4.1, Fig. 5).
-
-    The albedo of Lewis's specular function alone, computed by the one H_s
-    implementation, :func:`brdfkit.models.specular.specular_integral_with_error`
-    (azimuth in closed form, tanh-sinh in the polar angle; ~1e-11 relative),
-    not by the albedo engine. (The engine gives the same numbers for the
-    registered models whose BRDF is F_s itself: ``lafortune`` with ρ_d = 0,
-    ρ_s = 1, C_xy = −1, C_z = 1 is F_s^P, ``phong-blinn-reciprocal`` with
-    k_d = 0, k_s = 1 is F_s^B; the tests compare the two.)
-
-    Parameters
-    ----------
-    theta_i : float or array_like
-        Incidence angle(s) of S, radians in [0, π/2).
-    n : float
-        Specular exponent n_s ≥ 0.
-    lobe : {"phong", "blinn"}, keyword-only
-        F_s^P = max(0, R·V)^n (eq. 5) or F_s^B = (N·H)^n (eq. 6).
-    tol : float, keyword-only
-        Absolute accuracy goal (> 0). The quadrature's own accuracy (~1e-11
-        relative, H_s ≤ π) meets any goal above ~1e-10; ``error`` states what
-        was reached.
-
-    Returns
-    -------
-    AlbedoResult
-        ``albedo`` holds H_s, ``error`` its absolute error estimate (the
-        difference from the rule of twice the step plus rounding, a bound in
-        practice). Lewis eq. (19): k_ρ = k_d π + k_s H_s/(N·S). At θ_i = 0
-        with the Phong lobe, H_s = 2π/(n + 2) (eq. 16 with γ = n + 1).
-    """
-    # imported here: the rest of this module is the engine and does not need it
-    from brdfkit.models.specular import specular_integral_with_error
-
-    if lobe not in ("phong", "blinn"):
-        raise ParameterError(f"lobe must be 'phong' or 'blinn'; got {lobe!r}")
-    try:
-        n_val = float(n)
-    except (TypeError, ValueError):
-        n_val = float("nan")
-    if not (n_val >= 0.0 and math.isfinite(n_val)):
-        raise ParameterError(f"n must be a finite number >= 0; got {n!r}")
-    th = check_theta(theta_i)
-    tol = _check_tol(tol)
-    value, error = specular_integral_with_error(th, n_val, lobe)
-    # the same goal as the engine's: the tolerance or 1e-10 relative
-    met = np.asarray(error) <= np.maximum(tol, 1e-10 * np.abs(value))
-    status = np.where(met, CONVERGED, MAX_LEVEL_REACHED).astype(np.int8)
-    return AlbedoResult(theta=th.copy(), albedo=value, error=error, status=status)

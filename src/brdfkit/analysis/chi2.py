@@ -42,7 +42,9 @@ positive BRDF value, or when the pdf is 0 somewhere the BRDF is not
 Public objects
 --------------
 - :func:`chi2_test` — run the test for one model and one wo.
-- :class:`Chi2Result` — its outcome (``passed``, ``p_value``, ``message`` ...).
+- :class:`Chi2Result` — its outcome (``passed``, ``p_value``, ``status``/``success``/
+  ``message`` of ``brdfkit.status.STATUS["chi2"]``: passed, rejected, limit — passed with
+  unresolved quadrature cells —, nonfinite).
 - :func:`check_support` — pdf > 0 wherever f > 0 (called by :func:`chi2_test`).
 - :func:`sidak_alpha` — the per-test significance level.
 - :class:`SphereBinning` — the lobe-adapted binning (also usable alone).
@@ -66,11 +68,13 @@ from scipy import stats
 
 from brdfkit.errors import BrdfkitError
 from brdfkit.geometry import frame_around, reflect
+from brdfkit.status import STATUS
 
 __all__ = ["chi2_test", "Chi2Result", "check_support", "sidak_alpha", "SphereBinning",
            "lobe_axis_and_width"]
 
 MIN_EXPECTED = 5.0
+_CODES = STATUS["chi2"]
 
 
 def sidak_alpha(alpha: float, n_tests: int) -> float:
@@ -292,9 +296,14 @@ class Chi2Result:
     n_samples, n_valid : int
         Samples drawn; samples with pdf > 0 (histogrammed).
     message : str
-        Why it failed ("" when it passed), with the numbers.
+        The status's message, then why it failed, with the numbers.
     unresolved_cells : int
         Quadrature cells that did not reach tolerance (should be 0).
+    status : int
+        ``STATUS["chi2"]``: converged (0, passed), rejected (1), limit (2: passed, but
+        ``unresolved_cells`` > 0), nonfinite (3: the pdf is NaN or infinite somewhere).
+    success : bool
+        The status's success: the same as ``passed``.
     """
 
     passed: bool
@@ -310,9 +319,29 @@ class Chi2Result:
     unresolved_cells: int = 0
     observed: np.ndarray | None = field(default=None, repr=False)
     expected: np.ndarray | None = field(default=None, repr=False)
+    status: int = 0
+
+    @property
+    def success(self) -> bool:
+        return _CODES.success(self.status)
 
     def __bool__(self) -> bool:
         return self.passed
+
+
+def _status(fail: list[str], nonfinite: bool, unresolved: int) -> tuple[int, str]:
+    """(status, message) of a χ² run from its failure texts."""
+    if nonfinite:
+        code = _CODES.NONFINITE
+    elif fail:
+        code = _CODES.REJECTED
+    elif unresolved:
+        code = _CODES.LIMIT
+        fail = [f"{unresolved} cells unresolved"]
+    else:
+        code = _CODES.CONVERGED
+    text = _CODES.message(code)
+    return code, (f"{text}: {'; '.join(fail)}" if fail else text)
 
 
 def _pool(observed: np.ndarray, expected: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -423,6 +452,7 @@ def chi2_test(model, wo, *, n_samples: int = 200_000, seed=0, alpha: float = 0.0
     wi = np.asarray(wi, dtype=np.float64).reshape(n_samples, 3)
     pdf_s = np.asarray(pdf_s, dtype=np.float64).reshape(n_samples)
     fail = []
+    nonfinite = False
 
     finite = np.all(np.isfinite(wi), axis=-1) & np.isfinite(pdf_s)
     valid = finite & (pdf_s > 0.0)
@@ -484,6 +514,7 @@ def chi2_test(model, wo, *, n_samples: int = 200_000, seed=0, alpha: float = 0.0
     region = "the upper hemisphere" if lower == "pool" else "the sphere"
     if not np.isfinite(total):
         fail.append(f"pdf is not finite somewhere on {region}")
+        nonfinite = True
         total = math.inf
     elif total > 1.0 + 1e-3:
         fail.append(f"pdf integrates to {total:.6f} > 1 over {region}")
@@ -497,6 +528,7 @@ def chi2_test(model, wo, *, n_samples: int = 200_000, seed=0, alpha: float = 0.0
         sphere_total = float(np.sum(full))
         if not np.isfinite(sphere_total):
             fail.append("pdf is not finite somewhere on the sphere")
+            nonfinite = True
         elif sphere_total > 1.0 + 1e-2:
             fail.append(f"pdf integrates to {sphere_total:.4f} > 1 over the sphere")
     else:
@@ -521,10 +553,11 @@ def chi2_test(model, wo, *, n_samples: int = 200_000, seed=0, alpha: float = 0.0
     if p_value < level:
         fail.append(f"chi2 = {stat:.1f} with {dof} dof: p = {p_value:.3g} < {level:.3g}")
 
+    status, message = _status(fail, nonfinite, unresolved)
     return Chi2Result(
         passed=not fail, p_value=p_value, statistic=stat, dof=dof, alpha=level,
         pdf_integral=total, pdf_integral_sphere=sphere_total, n_samples=n_samples,
         n_valid=int(np.count_nonzero(valid)),
-        message="; ".join(fail), unresolved_cells=unresolved, observed=observed,
-        expected=expected,
+        message=message, unresolved_cells=unresolved, observed=observed,
+        expected=expected, status=status,
     )

@@ -27,6 +27,11 @@ whether it conserves energy (Lewis §4–5, Neumann §2):
   the normal (Lewis §3.3–3.4 against Neumann–Neumann and Minnaert), albedo
   that collapses at grazing incidence (Neumann §1.2, the "dark Phong mirror").
 
+Every verdict has a ``status`` (``brdfkit.status.STATUS["verdict"]``): *converged*
+when every part is decided, *undetermined* when reciprocity or energy is undetermined
+(the verdict says so rather than claim an answer), *nonfinite* when the albedo is NaN
+or infinite; ``success`` and ``message`` as for every result.
+
 Public objects
 --------------
 - :class:`Verdict` — the result (``to_dict`` gives the JSON of
@@ -50,6 +55,7 @@ import numpy as np
 from brdfkit.analysis.albedo_engine import albedo, evaluate_pairs
 from brdfkit.errors import BrdfkitError
 from brdfkit.models._base import BRDF
+from brdfkit.status import STATUS
 
 __all__ = ["Verdict", "check", "divergence_rate", "GRAZING_DEG", "RECIPROCITY_TOL"]
 
@@ -58,15 +64,22 @@ CONSERVE_SLACK = 1e-6
 GRAZING_DEG = (89.0, 89.9, 89.99, 89.999)
 _PAIR_THETA_DEG = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 85.0, 89.0, 89.9)
 _PAIR_DPHI_DEG = (0.0, 45.0, 90.0, 135.0, 180.0)
+_CODES = STATUS["verdict"]
 
 
 @dataclass
 class Verdict:
-    """Plausibility verdict of one model (see the module docstring for the rules)."""
+    """Plausibility verdict of one model (see the module docstring for the rules).
+
+    ``reciprocity`` ("reciprocal", "not reciprocal" or "undetermined": no pair with both
+    values) is the one record of the reciprocity verdict; ``reciprocal`` is derived from
+    it (True only for "reciprocal"). ``status`` is a code of ``STATUS["verdict"]``;
+    ``success`` and ``message`` follow from it (``detail`` adds what was undetermined).
+    """
 
     model: str
     params: dict
-    reciprocal: bool
+    reciprocity: str
     max_asymmetry: float
     energy: str
     max_albedo: float
@@ -82,9 +95,22 @@ class Verdict:
     theta_min_deg: float = 0.0
     #: The pumping stages of a pumped model (``PumpedBRDF.to_dict()["pump"]``), else None.
     pump: dict | list | None = None
-    #: "reciprocal", "not reciprocal", or "undetermined" (no pair with both values);
-    #: ``reciprocal`` is True only for the first.
-    reciprocity: str = ""
+    status: int = 0
+    detail: str = ""
+
+    @property
+    def reciprocal(self) -> bool:
+        """True when the reciprocity verdict is "reciprocal" (derived from ``reciprocity``)."""
+        return self.reciprocity == "reciprocal"
+
+    @property
+    def success(self) -> bool:
+        return _CODES.success(self.status)
+
+    @property
+    def message(self) -> str:
+        text = _CODES.message(self.status)
+        return f"{text} ({self.detail})" if self.detail else text
 
     def to_dict(self) -> dict:
         """JSON-ready dict with the keys of ``brdfkit check --json``."""
@@ -108,6 +134,9 @@ class Verdict:
             "min_albedo": float(self.min_albedo),
             "theta_min_deg": float(self.theta_min_deg),
             **({"pump": self.pump} if self.pump is not None else {}),
+            "status": int(self.status),
+            "success": self.success,
+            "message": self.message,
         }
 
 
@@ -216,10 +245,11 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
     if not np.all(np.isfinite(a)):
         # no verdict on energy from values that do not exist
         return Verdict(
-            model=d["model"], params=d["params"], reciprocal=bool(asym <= RECIPROCITY_TOL),
+            model=d["model"], params=d["params"], reciprocity=recip,
             max_asymmetry=asym, energy="undetermined", max_albedo=float("nan"),
             theta_max_deg=float("nan"), divergence_exponent=None, max_scale=None, notes=notes,
-            albedo_error=float("inf"), pump=d.get("pump"), reciprocity=recip)
+            albedo_error=float("inf"), pump=d.get("pump"), status=_CODES.NONFINITE,
+            detail="energy undetermined: the albedo is NaN or infinite")
 
     # --- divergence from the asymptotics, per channel
     ig = [int(np.argmin(np.abs(grid - g))) for g in GRAZING_DEG]
@@ -298,11 +328,16 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
 
     kmin = int(np.argmin(a.min(axis=1)[grid <= 89.0]))
     grazing = {g: float(a[i].max()) for g, i in zip(GRAZING_DEG, ig, strict=True)}
+    open_parts = [f"{part} undetermined" for part, v in (("reciprocity", recip),
+                                                         ("energy", energy))
+                  if v == "undetermined"]
     return Verdict(
-        model=d["model"], params=d["params"], reciprocal=bool(asym <= RECIPROCITY_TOL),
+        model=d["model"], params=d["params"], reciprocity=recip,
         max_asymmetry=asym, energy=energy, max_albedo=max_a, theta_max_deg=theta_max,
         divergence_exponent=p_rounded, max_scale=max_scale, notes=notes, grazing=grazing,
         slopes=slopes_worst, peaks_at_normal=peaks, albedo_error=err,
         min_albedo=float(a.min(axis=1)[kmin]), theta_min_deg=float(grid[kmin]),
-        pump=d.get("pump"), reciprocity=recip,
+        pump=d.get("pump"),
+        status=_CODES.UNDETERMINED if open_parts else _CODES.CONVERGED,
+        detail=", ".join(open_parts),
     )

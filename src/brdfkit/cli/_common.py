@@ -8,8 +8,9 @@ named, parameterised and reported the same way everywhere:
   options.
 - :func:`parse_param_items` — ``NAME=VALUE`` strings → keyword arguments
   (numbers, comma-separated per-channel/per-lobe lists, choice words; ``beta``
-  in degrees → radians).
-- :func:`build_model` — the model, optionally pumped (:mod:`brdfkit.pumping`).
+  in degrees → radians): :func:`brdfkit.spec.parse_items`.
+- :func:`build_model` — the model, optionally pumped: a
+  :class:`brdfkit.spec.ModelSpec` parsed from the words and built.
 - :func:`parse_direction` — ``THETA,PHI`` in degrees → unit vector.
 - :func:`emit_json` / :func:`to_jsonable` — JSON output (NumPy → lists,
   NaN/inf → null).
@@ -29,12 +30,9 @@ import click
 import numpy as np
 
 from brdfkit._io import to_jsonable
-from brdfkit._specs import canonical_name, model_params
-from brdfkit._specs import model as build_spec
 from brdfkit.cli._group import EXIT_USAGE
-from brdfkit.errors import BrdfkitError, ParameterError
-from brdfkit.pumping import MAX_TIMES
-from brdfkit.pumping import pump as pump_model
+from brdfkit.errors import BrdfkitError
+from brdfkit.spec import MAX_TIMES, TIMES_REASON, ModelSpec, parse_items, times_problem
 
 __all__ = [
     "EXIT_USAGE",
@@ -51,8 +49,7 @@ __all__ = [
 #: Largest ``--times``: the library's bound (each pumping tabulates the previous stage's
 #: albedo, so the cost grows with the number of stages; see ``brdfkit.pumping.MAX_TIMES``).
 PUMP_MAX_TIMES = MAX_TIMES
-_TIMES_REASON = ("each pumping tabulates the previous stage's albedo, so the cost grows with "
-                 "the number of stages: times=8 takes about a minute")
+_TIMES_REASON = TIMES_REASON
 
 #: Largest polar angle of a command-line direction, degrees. Above 90 the direction is
 #: below the horizon and every BRDF is 0 there (the package convention); 180 is straight
@@ -69,113 +66,19 @@ PARAM_HELP = (
 
 
 # --------------------------------------------------------------------------- parameters
-
-
-def _parse_number(text: str, name: str, model: str, bounds: str) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        raise ParameterError(
-            f"{model}: parameter {name!r} must be a number{bounds}; got {text!r}"
-        ) from None
-
-
 def parse_param_items(model_name: str, items: Iterable[str] | Mapping, *,
                       option: str = "-p") -> dict:
-    """Convert ``NAME=VALUE`` strings to keyword arguments for model *model_name*.
-
-    Parameters
-    ----------
-    model_name : str
-        A registered name or alias, or a material spec (``merl:nickel``, a
-        ``.binary`` path; raises :class:`~brdfkit.errors.UnknownModelError`).
-    items : iterable of str, or mapping
-        ``NAME=VALUE`` strings as typed on the command line. A mapping is
-        taken as already parsed and returned as a dict (no unit conversion).
-    option : str
-        The command-line option the items came from, named in the error for a
-        malformed item (``-p``, ``--start``).
-
-    Returns
-    -------
-    dict
-        Keyword arguments: floats, lists of floats (per channel/lobe), strings
-        (choices) or None (``none`` for optional parameters); ``beta`` is
-        converted from degrees to radians.
-
-    Raises
-    ------
-    ParameterError
-        Malformed item, repeated name or a value that is not a number.
-    """
-    label = canonical_name(model_name)
-    if isinstance(items, Mapping):
-        return dict(items)
-    decls = {p.name: p for p in model_params(model_name)}
-    out: dict = {}
-    for item in items:
-        name, sep, text = str(item).partition("=")
-        name, text = name.strip(), text.strip()
-        if not sep or not name or not text:
-            raise ParameterError(
-                f"parameter must be given as NAME=VALUE (e.g. {option} rho_d=0.5); got {item!r}"
-            )
-        if name in out:
-            raise ParameterError(f"{label}: parameter {name!r} given twice")
-        if name == "beta":
-            deg = _parse_number(text, "beta", label, " of degrees in (0, 90)")
-            if not 0.0 < deg < 90.0:
-                raise ParameterError(
-                    f"{label}: parameter 'beta' (half-angle, degrees on the command line) "
-                    f"must lie in (0, 90); got {text}"
-                )
-            out[name] = math.radians(deg)
-            continue
-        p = decls.get(name)
-        if p is None:
-            out[name] = text  # the model names the unknown parameter and lists the valid ones
-            continue
-        bounds = f" in {p.bounds_text()}"
-        if p.optional and text.lower() in ("none", "null"):
-            out[name] = None
-        elif p.kind == "choice":
-            out[name] = text
-        elif p.kind in ("colour", "lobes") and "," in text:
-            out[name] = [_parse_number(t.strip(), name, label, bounds)
-                         for t in text.split(",")]
-        else:
-            out[name] = _parse_number(text, name, label, bounds)
-    return out
-
-
-def _times_problem(times) -> str | None:
-    """Why *times* is not a valid ``--times`` (without the option name), or None."""
-    try:
-        ok = not isinstance(times, bool) and int(times) == times and 1 <= times <= PUMP_MAX_TIMES
-    except (TypeError, ValueError):  # not a number at all (e.g. a string through the API)
-        ok = False
-    if not ok:
-        return (f"must be an integer from 1 to {PUMP_MAX_TIMES}; got {times} "
-                f"({_TIMES_REASON})")
-    return None
+    """``NAME=VALUE`` strings → keyword arguments for model *model_name*
+    (:func:`brdfkit.spec.parse_items`: numbers, comma lists, choice words, ``none``;
+    ``beta`` in degrees → radians; a mapping is returned as a dict)."""
+    return parse_items(model_name, items, option=option)
 
 
 def build_model(name: str, params: Iterable[str] | Mapping = (), pump: str | None = None,
                 times: int | None = None):
-    """Build model *name* from command-line parameters, pumped if asked.
-
-    Parameters
-    ----------
-    name : str
-        Registered name or alias, or a material spec (``merl:nickel``,
-        ``rgl:NAME``, ``nielsen:NAME``, a ``.binary`` path).
-    params : iterable of ``NAME=VALUE`` str, or mapping
-        See :func:`parse_param_items`.
-    pump : {None, "max", "controlled"}
-        Apply :func:`brdfkit.pumping.pump` with this g.
-    times : int, optional
-        How many times to pump, 1 … :data:`PUMP_MAX_TIMES` (default 1); only
-        with *pump*.
+    """Build model *name* from command-line parameters, pumped if asked: the
+    :class:`~brdfkit.spec.ModelSpec` of the words (:meth:`~brdfkit.spec.ModelSpec.parse`),
+    built.
 
     Raises
     ------
@@ -183,22 +86,11 @@ def build_model(name: str, params: Iterable[str] | Mapping = (), pump: str | Non
         Unknown model, bad parameter, *times* out of range, or *times*
         given without *pump* (it would be silently ignored).
     """
-    kwargs = parse_param_items(name, params)
-    if pump is None and times is not None:
-        raise BrdfkitError(f"--times {times} needs --pump max or --pump controlled (it says how "
-                           "many times to pump); add --pump or drop --times")
-    m = build_spec(name, **kwargs)
-    if pump is None:
-        return m
-    times = 1 if times is None else times
-    problem = _times_problem(times)
-    if problem is not None:
-        raise BrdfkitError(f"--times {problem}")
-    return pump_model(m, g=pump, times=int(times))
+    return ModelSpec.parse(name, params, pump=pump, times=times).build()
 
 
 def _times_callback(ctx: click.Context, param: click.Parameter, value):
-    problem = None if value is None else _times_problem(value)
+    problem = None if value is None else times_problem(value)
     if problem is not None:
         raise click.BadParameter(problem, ctx=ctx, param=param)
     return value

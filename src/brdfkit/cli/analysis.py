@@ -19,7 +19,7 @@ import click
 import numpy as np
 
 import brdfkit.cli._progress as _progress
-from brdfkit._specs import is_material_spec
+from brdfkit.spec import is_material_spec
 from brdfkit.cli._common import build_model, emit_json, model_options
 from brdfkit.errors import BrdfkitError
 

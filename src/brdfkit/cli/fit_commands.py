@@ -18,8 +18,10 @@ import math
 import click
 
 import brdfkit.cli._progress as _progress
-from brdfkit.cli._common import PARAM_HELP, emit_json, parse_param_items
+from brdfkit.cli._common import PARAM_HELP, emit_json
 from brdfkit.errors import BrdfkitError
+from brdfkit.spec import ModelSpec, canonical_name, parse_items
+from brdfkit.fitting import LOSSES, PROCEDURES  # the registries' names (--loss, --procedure)
 
 __all__ = ["fit_cmd"]
 
@@ -39,9 +41,9 @@ __all__ = ["fit_cmd"]
               help="The material(s) to fit (repeatable): merl:NAME[@nbrdf|npf|abc|sgd], "
                    "rgl:NAME, nielsen:NAME, a MERL .binary path, or merl:all, rgl:all, "
                    "nielsen:all (every built-in material of the source).")
-@click.option("--loss", type=click.Choice(["l1", "l2", "ngan", "log", "perceptual"]),
+@click.option("--loss", type=click.Choice(list(LOSSES)),
               default="l1", show_default=True, help="The loss minimised (docs/fitting.md).")
-@click.option("--procedure", type=click.Choice(["auto", "staged", "nielsen", "direct"]),
+@click.option("--procedure", type=click.Choice(list(PROCEDURES)),
               default="auto", show_default=True, help="The fitting procedure.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of random starts.")
 @click.option("--starts", type=click.IntRange(min=1), default=3, show_default=True,
@@ -85,25 +87,23 @@ def fit_cmd(models, param, start, pump, times, to, loss, procedure, seed, starts
         raise BrdfkitError("--workers and --scheduler are for batches: add --out FILE.csv")
     model, to = models[0], targets[0]
     import brdfkit.data
-    from brdfkit.cli._common import build_model
     from brdfkit.fitting import fit
 
     if plot:  # matplotlib is imported only for a plot (~0.4 s of a one-line fit)
         from brdfkit.figures import check_output_path, save_atomic
 
         check_output_path(plot, option="--plot")  # fail before the fit, not after
-    given = parse_param_items(model, param)
-    both = sorted(set(given) & set(parse_param_items(model, start, option="--start")))
+    held = parse_items(model, param)
+    started = parse_items(model, start, option="--start")
+    both = sorted(set(held) & set(started))
     if both:
         raise BrdfkitError(f"{', '.join(both)}: given with both -p (held) and --start (fitted); "
                            "use one")
-    m = build_model(model, (*start, *param), pump=pump, times=times)
-    if "beta" in given:
-        if m.width_param is None:
-            raise BrdfkitError(f"{model}: has no lobe width, so 'beta' is not a parameter")
-        given[m.width_param] = m.values[m.width_param]
-        del given["beta"]
-    fixed = {k: m.values[k] for k in given}
+    spec = ModelSpec.parse(model, {**started, **held}, pump=pump, times=times)
+    m = spec.build()
+    # a held beta (half-angle) is held as the width parameter the spec resolved it into
+    width = next(iter(set(spec.params) - set(started) - set(held)), None)
+    fixed = {k: m.values[k] for k in (width if k == "beta" else k for k in held)}
     target = brdfkit.data.material(to)
     r = fit(m, target, loss=loss, procedure=procedure, fixed=fixed, seed=seed, n_starts=starts,
             theta_max=None if theta_max is None else math.radians(theta_max))
@@ -131,7 +131,6 @@ def fit_cmd(models, param, start, pump, times, to, loss, procedure, seed, starts
 def _batch(models, targets, *, param, start, pump, times, loss, procedure, seed, theta_max, as_json,
            plot, out, workers, scheduler) -> None:
     """``brdfkit fit MODEL... --to SPEC... --out FILE.csv``: one row per fit."""
-    from brdfkit._specs import canonical_name
     from brdfkit.fitting.batch import Job, fit_row, run_batch
 
     if out is None:
@@ -148,7 +147,7 @@ def _batch(models, targets, *, param, start, pump, times, loss, procedure, seed,
         canonical_name(m)  # an unknown model fails now, not in every row
     starts = {}
     for m in models if start else ():  # starting values; every model must take them
-        starts = parse_param_items(m, start, option="--start")
+        starts = parse_items(m, start, option="--start")
         if "beta" in starts:
             raise BrdfkitError("--start beta=...: a batch takes the models' own parameter "
                                "names (the width parameter, not beta)")

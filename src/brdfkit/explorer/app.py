@@ -48,15 +48,14 @@ from fastapi.responses import HTMLResponse, JSONResponse, Response
 
 from brdfkit._cache import bounded_cache
 from brdfkit._io import to_jsonable
-from brdfkit._specs import model as build_spec
 from brdfkit.data import material_names
 from brdfkit.data.export import export_merl
 from brdfkit.errors import BrdfkitError
 from brdfkit.explorer import views
 from brdfkit.models import MODELS
-from brdfkit.pumping import MAX_TIMES, pump
+from brdfkit.spec import MAX_TIMES, ModelSpec
 
-__all__ = ["create_app", "build_entry", "parse_state"]
+__all__ = ["create_app", "build_entry", "entry_spec", "parse_state"]
 
 #: Models and view sets kept per app (LRU): a session flips between a few models; a pumped
 #: model holds its tables (up to a few MB)
@@ -95,8 +94,11 @@ def parse_state(state: dict) -> dict:
     }
 
 
-def build_entry(entry: dict):
-    """A model from one state entry ``{"spec", "params", "pump", "times"}``."""
+def entry_spec(entry: dict) -> ModelSpec:
+    """The :class:`~brdfkit.spec.ModelSpec` of one state entry ``{"spec", "params",
+    "pump", "times"}``: the spec's flat dict form with the page's conventions — the
+    name under ``spec``, empty fields dropped, ``beta`` in degrees (as on the command
+    line)."""
     if not isinstance(entry, dict) or not isinstance(entry.get("spec"), str):
         raise BrdfkitError("each model entry needs a 'spec' string (a model name or material)")
     params = entry.get("params") or {}
@@ -105,16 +107,14 @@ def build_entry(entry: dict):
     params = {k: v for k, v in params.items() if v is not None and v != ""}
     if "beta" in params:  # degrees in the UI, as on the command line
         params["beta"] = math.radians(float(params["beta"]))
-    m = build_spec(entry["spec"], **params)
-    g = entry.get("pump")
-    if g in (None, "", "none"):
-        return m
-    if g not in ("max", "controlled"):
-        raise BrdfkitError(f"pump must be 'max', 'controlled' or none; got {g!r}")
-    times = entry.get("times", 1)
-    if not (isinstance(times, int) and 1 <= times <= MAX_TIMES):
-        raise BrdfkitError(f"times must be an integer from 1 to {MAX_TIMES}; got {times!r}")
-    return pump(m, g=g, times=times)
+    return ModelSpec.from_dict({"model": entry["spec"], "params": params,
+                                **{k: entry[k] for k in ("pump", "times") if k in entry}})
+
+
+def build_entry(entry: dict):
+    """A model from one state entry ``{"spec", "params", "pump", "times"}``
+    (:func:`entry_spec`, built)."""
+    return entry_spec(entry).build()
 
 
 async def _body(request: Request):
@@ -263,7 +263,7 @@ def create_app():
             raise BrdfkitError("fit: give {'model': {...}, 'target': SPEC, 'loss': ...}")
         loss = body.get("loss", "l1")
         m = get_model(body.get("model"))
-        target = build_spec(body["target"])
+        target = ModelSpec(body["target"]).build()
         job_id = next(fit_ids)
         fits[job_id] = {"state": "running", "stage": "starting", "evaluations": 0,
                         "t0": time.perf_counter(), "model": m.name, "target": target.name}

@@ -52,13 +52,13 @@ def serve(*, specs=(), host: str = LOCALHOST, port: int = DEFAULT_PORT, open_bro
     """Serve until Ctrl-C. *specs* (model names or material specs) are validated first."""
     import uvicorn
 
-    from brdfkit._specs import model as build_spec
     from brdfkit.explorer.app import create_app
+    from brdfkit.spec import canonical_name
 
     if not (isinstance(port, int) and 0 < port < 65536):
         raise BrdfkitError(f"--port must be an integer from 1 to 65535; got {port!r}")
     for s in specs:
-        build_spec(s)  # an unknown spec fails here, with the dispatcher's did-you-mean message
+        canonical_name(s)  # an unknown spec fails here, with the dispatcher's did-you-mean message
     _check_free(host, port)
     url = start_url(host, port, specs)
     where = ("this machine only" if host == LOCALHOST else

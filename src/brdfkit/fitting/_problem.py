@@ -16,12 +16,12 @@ must equal f₀ + Σ c_k B_k to 10⁻⁶ of its largest value), so no model is n
 the Phong family, Ward and Lafortune pass; a pumped model (f/g, with g
 depending on them) does not. For fixed shape parameters the linear ones are
 solved per channel in closed form (:mod:`brdfkit.fitting._linear`): the
-box-constrained least squares exactly (``l2``; ``ngan`` over its samples with θ_i, θ_o ≤
-80°, as its metric; also the inner solve
-for ``log`` and ``perceptual``, whose stage iii then optimises everything
-under the loss itself), L1 (``l1``) by iteratively reweighted least squares
+box-constrained least squares exactly, or L1 by iteratively reweighted least squares
 from the L2 solution, warm-started from the previous solution
-(:data:`IRLS_ITERATIONS` steps at most).
+(:data:`IRLS_ITERATIONS` steps at most) — which of the two, over which samples
+(``ngan``: θ_i, θ_o ≤ 80°, as its metric) and whether it is exact, is the loss's
+(:class:`brdfkit.fitting.losses.Loss`; ``log`` and ``perceptual`` solve under L2, and
+their stage iii then optimises everything under the loss itself).
 """
 
 from __future__ import annotations
@@ -33,9 +33,9 @@ import warnings
 import numpy as np
 
 from brdfkit.errors import BrdfkitError
-from brdfkit.fitting._linear import solve_channels
-from brdfkit.fitting.losses import NGAN_THETA_MAX_DEG, loss_value
-from brdfkit.fitting.samples import albedo_from_values, albedo_nodes
+from brdfkit.fitting.losses import Loss
+from brdfkit.fitting.losses import loss as get_loss
+from brdfkit.fitting.samples import albedo_from_values
 
 __all__ = ["Problem", "IRLS_ITERATIONS"]
 
@@ -43,17 +43,16 @@ __all__ = ["Problem", "IRLS_ITERATIONS"]
 IRLS_ITERATIONS = 3
 #: Relative tolerance of the numerical linearity test.
 LINEAR_RTOL = 1e-6
-#: θ_i of the albedo term of the perceptual loss (degrees) and its node counts.
-PERCEPTUAL_THETA_DEG = tuple(float(t) for t in range(0, 81, 10))
 
 
 class Problem:
     """Samples, target and model of one fit (see the module docstring)."""
 
-    def __init__(self, model, target, samples, loss: str, n_channels: int):
+    def __init__(self, model, target, samples, loss: str | Loss, n_channels: int):
         self.model = model
         self.samples = samples
-        self.loss = loss
+        self.objective = get_loss(loss)  # the Loss object (brdfkit.fitting.losses)
+        self.loss = self.objective.name
         self.C = n_channels
         self.n_evals = 0
         self.n_invalid = 0
@@ -63,7 +62,7 @@ class Problem:
         s = samples
         self.w = s.weight
         self.cos = s.cos_i[:, None]
-        y = self._values(target, s.wi, s.wo)
+        y = self.evaluate(target, s.wi, s.wo)
         ok = np.all(np.isfinite(y), axis=1)
         if not np.any(ok):
             raise BrdfkitError("fit: the target is not finite at any sample (no measured bin)")
@@ -71,35 +70,57 @@ class Problem:
             self.samples = s = s.subset(ok)
             self.w, self.cos, y = s.weight, s.cos_i[:, None], y[ok]
         self.y = y * self.cos
-        self.ngan_mask = ((s.wi[:, 2] >= math.cos(math.radians(NGAN_THETA_MAX_DEG)))
-                          & (s.wo[:, 2] >= math.cos(math.radians(NGAN_THETA_MAX_DEG))))
-        # the weights of the linear solve: Ngan's metric is over θ_i, θ_o ≤ 80° only, so its
-        # solve is too (with all samples the "exact" projection was not: the Lafortune anchor
-        # fits of red-plastic ended at L 0.0104 where their own shape's optimum is 0.0087)
-        self.w_solve = (np.ascontiguousarray(self.w * self.ngan_mask) if loss == "ngan"
-                        else self.w)
+        self._masks: dict = {}  # loss name → its sample mask on these samples
+        self.mask = self.mask_of(self.objective)
+        # the weights of the linear solve: over the loss's samples only (ngan: θ ≤ 80°)
+        self.w_solve = (self.w if self.mask is None
+                        else np.ascontiguousarray(self.w * self.mask))
         self._w_solve_sum = float(np.sum(self.w_solve))
         self.albedo_t = None
-        if loss == "perceptual":
-            self._perceptual_albedo(target)
+        if self.objective.needs_albedo:
+            self._loss_albedo(target)
 
-    def _perceptual_albedo(self, target) -> None:
-        self._anodes = albedo_nodes(PERCEPTUAL_THETA_DEG, n_u=24, n_phi=12)
+    def _loss_albedo(self, target) -> None:
+        self._anodes = self.objective.albedo_nodes()
         wi, wo, wa, T = self._anodes
-        self.albedo_t = albedo_from_values(self._values(target, wi, wo), wa, T)
+        self.albedo_t = albedo_from_values(self.evaluate(target, wi, wo), wa, T)
 
-    def perceptual(self, target) -> Problem:
-        """This problem under the ``perceptual`` loss (the samples and target values
-        shared, not evaluated again)."""
-        if self.loss == "perceptual":
+    def mask_of(self, loss: Loss):
+        """*loss*'s sample mask on these samples (:meth:`Loss.sample_mask`), or None."""
+        if loss.name not in self._masks:
+            self._masks[loss.name] = loss.sample_mask(self.samples)
+        return self._masks[loss.name]
+
+    @property
+    def ngan_mask(self):
+        """The samples with θ_i, θ_o ≤ 80° (the ``ngan`` loss's mask)."""
+        return self.mask_of(get_loss("ngan"))
+
+    def under(self, loss: str | Loss, target) -> Problem:
+        """This problem under another *loss* (the samples and target values shared, not
+        evaluated again; the target's albedo computed if that loss needs it)."""
+        loss = get_loss(loss)
+        if loss is self.objective:
             return self
         other = copy.copy(self)
-        other.loss = "perceptual"
-        other._perceptual_albedo(target)
+        other.objective, other.loss = loss, loss.name
+        other.mask = other.mask_of(loss)
+        other.w_solve = (self.w if other.mask is None
+                         else np.ascontiguousarray(self.w * other.mask))
+        other._w_solve_sum = float(np.sum(other.w_solve))
+        if loss.needs_albedo:
+            other._loss_albedo(target)
+        return other
+
+    def with_model(self, model) -> Problem:
+        """This problem with another *model* to build (e.g. the exact model after a fit
+        through a stand-in), the samples and target values shared."""
+        other = copy.copy(self)
+        other.model = model
         return other
 
     # ------------------------------------------------------------------ evaluation
-    def _values(self, m, wi, wo, *, per_channel: bool = True) -> np.ndarray:
+    def evaluate(self, m, wi, wo, *, per_channel: bool = True) -> np.ndarray:
         """f at the pairs, (N, C); (N, 1) for a model without per-channel parameters when
         not *per_channel* (left to broadcast)."""
         f = np.asarray(m.eval(wi, wo), dtype=np.float64).reshape(wi.shape[0], -1)
@@ -120,25 +141,26 @@ class Problem:
                 return None
 
     def predict(self, values: dict, *, per_channel: bool = True):
-        """(model, f·cos θ_i at the samples (N, C), or (N, 1) as :meth:`_values` says),
+        """(model, f·cos θ_i at the samples (N, C), or (N, 1) as :meth:`evaluate` says),
         or (None, None)."""
         m = self.build(values)
         if m is None:
             return None, None
         self.n_evals += 1
-        return m, self._values(m, self.samples.wi, self.samples.wo,
-                               per_channel=per_channel) * self.cos
+        return m, self.evaluate(m, self.samples.wi, self.samples.wo,
+                                per_channel=per_channel) * self.cos
 
-    def loss_of(self, m, pred, loss: str | None = None) -> float:
-        loss = loss or self.loss
+    def loss_of(self, m, pred, loss: str | Loss | None = None) -> float:
+        """The loss (this problem's, or *loss*) of model *m* with predictions *pred*."""
+        L = self.objective if loss is None else get_loss(loss)
         if pred is None or not np.all(np.isfinite(pred)):
             return math.inf
         am = None
-        if loss == "perceptual":
+        if L.needs_albedo:
             wi, wo, wa, T = self._anodes
-            am = albedo_from_values(self._values(m, wi, wo), wa, T)
-        return loss_value(loss, pred, self.y, self.w, ngan_mask=self.ngan_mask,
-                          albedo_m=am, albedo_t=self.albedo_t)
+            am = albedo_from_values(self.evaluate(m, wi, wo), wa, T)
+        return L.value(pred, self.y, self.w, mask=self.mask_of(L), albedo_m=am,
+                       albedo_t=self.albedo_t)
 
     def loss_at(self, values: dict) -> float:
         m, pred = self.predict(values)
@@ -207,12 +229,12 @@ class Problem:
         scale = max(float(np.max(np.abs(expect))), 1e-300)
         return float(np.max(np.abs(got_f - expect))) <= LINEAR_RTOL * scale
 
-    def solve_linear(self, f0, B, lo, hi, loss: str, *,
+    def solve_linear(self, f0, B, lo, hi, *,
                      iterations: int = IRLS_ITERATIONS) -> tuple[np.ndarray, float | None]:
-        """Per-channel linear parameters P (K, C) minimising the L1 (``l1``, at most
-        *iterations* IRLS steps) or L2 (other losses) norm, and the loss at P for ``l1``,
-        ``l2`` and ``ngan`` (None for the others: their value needs the prediction)
-        (:func:`brdfkit.fitting._linear.solve_channels`)."""
+        """Per-channel linear parameters P (K, C) under this problem's loss's solve
+        (:meth:`brdfkit.fitting.losses.Loss.solve`: L1 by at most *iterations* IRLS steps,
+        or L2, over the loss's samples), and the loss at P where the solve gives it (None
+        otherwise: the value needs the prediction)."""
         K = len(B)
         start = (self._warm if self._warm is not None and self._warm.shape == (K, self.C)
                  else np.empty((0, 0)))
@@ -222,12 +244,8 @@ class Problem:
             R = self._r_static
         else:
             R = np.ascontiguousarray(self.y - f0)
-        P, total = solve_channels(np.stack(B), R, self.w_solve, lo, hi, loss == "l1", iterations,
-                                  start)
+        P, value = self.objective.solve(np.stack(B), R, self.w_solve, lo, hi,
+                                        iterations=iterations, start=start,
+                                        w_sum=self._w_solve_sum)
         self._warm = P.copy()
-        # the normalisation of losses.loss_value: Σ w |d| / (Σ w · C), for ngan over its
-        # samples (w_solve) and its square root
-        if loss not in ("l1", "l2", "ngan"):
-            return P, None
-        value = total / (self._w_solve_sum * self.C)
-        return P, (math.sqrt(value) if loss == "ngan" else value)
+        return P, value

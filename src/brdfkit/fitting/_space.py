@@ -16,6 +16,21 @@ lobe of a per-lobe parameter) is optimised as an unbounded coordinate z:
 σ is the logistic function. So every z gives a valid parameter and the bounds
 are approached, never crossed: a coordinate at a bound shows as |z| large,
 reported by :meth:`Coord.at_bound`.
+
+A fit's parameters live in one form, a dict of parameter values (per-channel and
+per-lobe values as arrays); :class:`ParameterSpace` is the one object that reads a
+coordinate from it (:meth:`ParameterSpace.x`), maps coordinates to z and back
+(:meth:`ParameterSpace.z`, :meth:`ParameterSpace.point`) and knows which coordinates are
+free: every declared parameter but choices, optional ones that are None and fixed ones
+(:meth:`ParameterSpace.of_model`), less those a fit holds (gauges of
+``BRDF.fit_gauge``, inert ones, a scale a pumped model does not see:
+:meth:`ParameterSpace.hold`).
+
+Public objects
+--------------
+- :class:`Coord` — one free scalar and its transform.
+- :class:`ParameterSpace` — the free coordinates of a fit.
+- :data:`LOG_FLOOR`, :data:`BOUND_TOL`, :data:`Z_MAX`.
 """
 
 from __future__ import annotations
@@ -25,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Coord", "LOG_FLOOR", "BOUND_TOL", "Z_MAX"]
+__all__ = ["Coord", "ParameterSpace", "LOG_FLOOR", "BOUND_TOL", "Z_MAX"]
 
 #: Stands for a lower bound of 0 in the log reparametrisation.
 LOG_FLOOR = 1e-6
@@ -138,22 +153,104 @@ class Coord:
         return 0.2 * max(abs(x), 0.1)
 
 
-def as_vector(values: dict, coords) -> np.ndarray:
-    """z of each coordinate for parameter *values*."""
-    out = np.empty(len(coords))
-    for k, c in enumerate(coords):
+class ParameterSpace:
+    """The free coordinates of a fit (module docstring).
+
+    Attributes
+    ----------
+    coords : list of Coord
+        The coordinates free now (the methods' *coords* default to them).
+    """
+
+    def __init__(self, coords):
+        self.coords = list(coords)
+
+    @classmethod
+    def of_model(cls, model, fixed: dict, n_channels: int) -> tuple[ParameterSpace, dict]:
+        """The space of every free scalar of *model* and the values to start from: its
+        own, colour parameters broadcast to *n_channels*, lobe ones to its lobes, *fixed*
+        set."""
+        C = n_channels
+        values = model.values
+        coords = []
+        for p in model.params:
+            v = values[p.name]
+            if p.kind == "choice" or p.name in fixed or (p.optional and v is None):
+                continue
+            if p.kind == "colour":
+                arr = np.broadcast_to(np.atleast_1d(np.asarray(v, dtype=np.float64)),
+                                      (C,)).copy()
+                values[p.name] = arr if C > 1 else float(arr[0])
+                coords += [Coord.for_param(p, c if C > 1 else None) for c in range(C)]
+            elif p.kind == "lobes":
+                arr = np.broadcast_to(np.atleast_1d(np.asarray(v, dtype=np.float64)),
+                                      (model.n_lobes(),)).copy()
+                values[p.name] = arr
+                coords += [Coord.for_param(p, k) for k in range(arr.size)]
+            else:
+                coords.append(Coord.for_param(p))
+        values.update(fixed)
+        return cls(coords), values
+
+    # ------------------------------------------------------------------ reading
+    @staticmethod
+    def x(values: dict, c: Coord) -> float:
+        """The value of coordinate *c* in parameter *values*."""
         v = values[c.name]
-        out[k] = c.to_z(float(v if c.index is None else np.asarray(v)[c.index]))
-    return out
+        return float(v if c.index is None else np.asarray(v)[c.index])
 
+    def z(self, values: dict, coords=None) -> np.ndarray:
+        """z of each coordinate for parameter *values*."""
+        coords = self.coords if coords is None else coords
+        out = np.empty(len(coords))
+        for k, c in enumerate(coords):
+            out[k] = c.to_z(self.x(values, c))
+        return out
 
-def from_vector(z, coords, base: dict) -> dict:
-    """Parameter values: *base* with the coordinates set from *z* (arrays copied)."""
-    out = {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in base.items()}
-    for zk, c in zip(z, coords, strict=True):
-        x = c.to_x(float(zk))
-        if c.index is None:
-            out[c.name] = x
-        else:
-            out[c.name][c.index] = x
-    return out
+    @staticmethod
+    def point(z, coords, base: dict) -> dict:
+        """Parameter values: *base* with the coordinates *coords* set from *z* (arrays
+        copied)."""
+        out = {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in base.items()}
+        for zk, c in zip(z, coords, strict=True):
+            x = c.to_x(float(zk))
+            if c.index is None:
+                out[c.name] = x
+            else:
+                out[c.name][c.index] = x
+        return out
+
+    def steps(self, values: dict, coords=None) -> np.ndarray:
+        """The initial simplex steps in z (:meth:`Coord.step`) at *values*."""
+        coords = self.coords if coords is None else coords
+        return np.array([c.step(self.x(values, c)) for c in coords])
+
+    def labels(self, coords=None) -> list[str]:
+        return [c.label for c in (self.coords if coords is None else coords)]
+
+    def names(self, coords=None) -> list[str]:
+        """The parameter names of the coordinates, each once, in order."""
+        return list(dict.fromkeys(c.name for c in (self.coords if coords is None
+                                                   else coords)))
+
+    def at_bounds(self, values: dict) -> list[str]:
+        """Labels of the free coordinates at a bound (:meth:`Coord.at_bound`)."""
+        return [c.label for c in self.coords if c.at_bound(self.x(values, c))]
+
+    def jsonable(self, values: dict) -> dict:
+        """The free parameters of *values*, JSON-ready (lists for arrays)."""
+        names = {c.name for c in self.coords}
+        return {k: (v.tolist() if isinstance(v, np.ndarray) else v)
+                for k, v in values.items() if k in names}
+
+    # ------------------------------------------------------------------ holding
+    def hold(self, held) -> None:
+        """Hold the coordinates *held* (an iterable of Coord): no longer free."""
+        held = list(held)
+        self.coords = [c for c in self.coords if c not in held]
+
+    def gauges(self, model, values: dict) -> list[Coord]:
+        """The free coordinates that are a gauge freedom of *model* (``BRDF.fit_gauge``)
+        and not 0 at *values* (at 0 the other coordinates no longer absorb it)."""
+        return [c for c in self.coords
+                if c.label in model.fit_gauge and self.x(values, c) != 0.0]

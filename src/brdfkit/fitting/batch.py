@@ -38,6 +38,7 @@ Public objects
 - :class:`Job`, :func:`run_batch`, :class:`BatchReport`, :class:`BatchInterrupted`,
   :func:`read_rows`, :func:`write_rows`.
 - :func:`fit_row` — the job function of ``brdfkit fit … --out``: one fit, one row.
+- :func:`job_spec` — the :class:`~brdfkit.spec.ModelSpec` of a job's model.
 - :func:`expand_targets` — ``merl:all``, ``rgl:all``, ``nielsen:all`` → material specs.
 """
 
@@ -58,7 +59,7 @@ from brdfkit.errors import BrdfkitError
 
 __all__ = ["Job", "run_batch", "BatchReport", "BatchInterrupted", "read_rows", "write_rows",
            "SUFFIXES",
-           "fit_row", "expand_targets", "KEY_COLUMNS", "STATUS_OK", "STATUS_ERROR",
+           "fit_row", "job_spec", "expand_targets", "KEY_COLUMNS", "STATUS_OK", "STATUS_ERROR",
            "STATUS_NOT_CONVERGED"]
 
 #: Columns that identify a job's row (its key), first in every output file.
@@ -391,6 +392,21 @@ def expand_targets(specs: Iterable[str]) -> list[str]:
     return list(dict.fromkeys(out))
 
 
+def job_spec(job: Job):
+    """The :class:`~brdfkit.spec.ModelSpec` a job fits (or a derived job rebuilds):
+    ``job.model`` with the options ``params`` (a JSON object of values), ``pump`` (g)
+    and ``times`` — the spec's flat dict form."""
+    import json
+
+    from brdfkit.spec import ModelSpec
+
+    opts = dict(job.options)
+    d = {"model": job.model, "params": json.loads(opts["params"]) if opts.get("params") else {}}
+    if opts.get("pump"):
+        d.update(pump=opts["pump"], times=int(opts.get("times", 1)))
+    return ModelSpec.from_dict(d)
+
+
 def fit_row(job: Job) -> dict:
     """Fit ``job.model`` to ``job.target`` (:func:`brdfkit.fitting.fit`) and flatten the
     result into one row: status (ok / not-converged), the loss value, the parameters (JSON,
@@ -404,18 +420,13 @@ def fit_row(job: Job) -> dict:
 
     import numpy as np
 
-    from brdfkit._specs import model as build_spec
     from brdfkit.fitting.procedure import fit
-    from brdfkit.pumping import pump
+    from brdfkit.spec import ModelSpec
 
     opts = dict(job.options)
-    m = build_spec(job.model)
-    if opts.get("params"):
-        m = m.with_params(**json.loads(opts["params"]))  # validated by the model
+    m = job_spec(job).build()
     fixed = {k: m.values[k] for k in json.loads(opts.get("fixed") or "[]")}
-    if opts.get("pump"):
-        m = pump(m, g=opts["pump"], times=int(opts.get("times", 1)))
-    target = build_spec(job.target)
+    target = ModelSpec(job.target).build()
     theta_max = opts.get("theta_max_deg")
     t0 = time.perf_counter()
     r = fit(m, target, loss=job.loss, procedure=job.procedure, seed=int(opts.get("seed", 0)),

@@ -67,6 +67,7 @@ from brdfkit.fitting.batch import (
     STATUS_OK,
     Job,
     fit_row,
+    job_spec,
     read_rows,
     run_batch,
 )
@@ -241,15 +242,10 @@ def derived_jobs(batch: StudyBatch, directory) -> list[Job]:
 
 
 def _rebuild(job: Job):
-    import brdfkit
-    from brdfkit.pumping import pump
+    """The fitted model of a derived job (its row's spec, :func:`job_spec`) and its target."""
+    from brdfkit.spec import ModelSpec
 
-    opts = dict(job.options)
-    params = json.loads(opts["params"])
-    m = brdfkit.model(job.model, **{k: v for k, v in params.items() if v is not None})
-    if opts.get("pump"):
-        m = pump(m, g=opts["pump"], times=1)
-    return m, brdfkit.data.material(job.target)
+    return job_spec(job).build(), ModelSpec(job.target).build()
 
 
 def derived_row(job: Job) -> dict:
@@ -281,11 +277,11 @@ def relative_errors(model, target) -> tuple[float, float]:
 
     C = int(target.n_channels or 1)
     prob = Problem(model, target, merl_samples(), "perceptual", C)
-    m = prob._values(model, prob.samples.wi, prob.samples.wo) * prob.cos
+    m = prob.evaluate(model, prob.samples.wi, prob.samples.wo) * prob.cos
     tau = TAU_REL * (prob.w @ prob.y) / np.sum(prob.w)
     e_point = float(np.max(np.abs(np.log((np.maximum(m, 0.0) + tau) / (prob.y + tau)))))
     wi, wo, wa, T = prob._anodes
-    a_m = albedo_from_values(prob._values(model, wi, wo), wa, T)
+    a_m = albedo_from_values(prob.evaluate(model, wi, wo), wa, T)
     tiny = 1e-12  # as the loss: an albedo of exactly 0 has an infinite log ratio
     e_albedo = float(np.max(np.abs(np.log(np.maximum(a_m, tiny)
                                           / np.maximum(prob.albedo_t, tiny)))))
@@ -359,7 +355,7 @@ def read_ngan_table(path) -> dict:
 def ngan_model(entry: dict, convention: str = "peak-one"):
     """Ngan's Lafortune fit as a brdfkit ``lafortune`` model under *convention*
     (:data:`NGAN_CONVENTIONS`)."""
-    import brdfkit
+    from brdfkit.spec import ModelSpec
 
     if convention not in NGAN_CONVENTIONS:
         raise BrdfkitError(f"convention must be one of {', '.join(NGAN_CONVENTIONS)}; got "
@@ -371,8 +367,8 @@ def ngan_model(entry: dict, convention: str = "peak-one"):
         c_xy, c_z = c_xy / big, c_z / big
     if convention == "normalised":
         rho_s = [r * (n + 2.0) / (2.0 * math.pi) for r in rho_s]
-    return brdfkit.model("lafortune", rho_d=entry["rho_d"], rho_s=rho_s, C_xy=c_xy, C_z=c_z,
-                         n=n)
+    return ModelSpec("lafortune", {"rho_d": entry["rho_d"], "rho_s": rho_s, "C_xy": c_xy,
+                                   "C_z": c_z, "n": n}).build()
 
 
 def ngan_metric(model, target) -> float:
@@ -382,7 +378,7 @@ def ngan_metric(model, target) -> float:
     from brdfkit.fitting.samples import merl_samples
 
     prob = Problem(model, target, merl_samples(), "ngan", int(target.n_channels or 1))
-    pred = prob._values(model, prob.samples.wi, prob.samples.wo) * prob.cos
+    pred = prob.evaluate(model, prob.samples.wi, prob.samples.wo) * prob.cos
     return prob.loss_of(model, pred)
 
 

@@ -154,6 +154,15 @@ class BRDF:
     #: 1 Blinn-like): a fit also starts its search near each bound, so that it does not
     #: settle in one end's basin when the other end fits better.
     fit_bound_starts: ClassVar[tuple[str, ...]] = ()
+    #: The model a fit of this derived model starts from, or None (a model fitted on its
+    #: own). A fit of a model with a ``fit_base`` and no parameters it can solve in
+    #: closed form (a pumped model: g depends on them) fits the base first — faster, its
+    #: linear parameters in closed form — and starts its joint stage from the base's
+    #: optimum; a half-width's first guess of the width uses the base's
+    #: ``width_from_beta`` (the lobe keeps its shape). How it is evaluated meanwhile is the
+    #: operator's (``brdfkit.pumping.surrogate``: a fast stand-in). Pumped models: their
+    #: unpumped root.
+    fit_base: BRDF | None = None
     #: Compiled loop specialised to ``kernel`` (:func:`checked_driver`), or None for the
     #: generic :func:`eval_pairs_checked` (a composite kernel, e.g. pumped, sets one).
     _driver: Callable | None = None

@@ -115,6 +115,11 @@ class PumpedBRDF(DerivedBRDF):
         albedo; empty for a custom g (evaluated in NumPy from ``table``).
     """
 
+    @property
+    def fit_base(self) -> BRDF:
+        """A fit starts from the unpumped root's fit (``BRDF.fit_base``)."""
+        return self.root
+
     def __init__(self, base: BRDF, g: str | Callable = "max"):
         self.base = base
         self.root = base.root if isinstance(base, PumpedBRDF) else base
@@ -567,17 +572,9 @@ def mirror_radiance(model, theta) -> np.ndarray:
 
 
 def from_dict(d: dict) -> BRDF:
-    """Rebuild a model from :meth:`BRDF.to_dict` / :meth:`PumpedBRDF.to_dict` output."""
-    from brdfkit.models import model as make
+    """Rebuild a model from :meth:`BRDF.to_dict` / :meth:`PumpedBRDF.to_dict` output —
+    a registered model or a material (``merl:…``), pumped or not — through
+    :class:`brdfkit.spec.ModelSpec`."""
+    from brdfkit.spec import ModelSpec
 
-    if not isinstance(d, dict) or "model" not in d:
-        raise ParameterError(f"from_dict: expected a dict with a 'model' key; got {d!r}")
-    m = make(d["model"], **d.get("params", {}))
-    chain = d.get("pump")
-    if chain is None:
-        return m
-    for stage in ([chain] if isinstance(chain, dict) else chain):
-        if stage.get("g") == "custom":
-            raise ParameterError("from_dict: a custom g cannot be rebuilt from a dict")
-        m = pump(m, stage.get("g", "max"), times=int(stage.get("times", 1)))
-    return m
+    return ModelSpec.from_dict(d).build()

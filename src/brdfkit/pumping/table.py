@@ -126,7 +126,7 @@ class AlbedoTable:
 
 def _engine(model, tol: float = ENGINE_TOL) -> Callable:
     """The albedo engine as ``theta -> (T,) or (T, C)`` for *model*, to accuracy *tol*."""
-    from brdfkit.analysis import albedo  # the engine is a higher layer: imported when used
+    from brdfkit.analysis import albedo  # imported when used (a pumping builds it; start-up)
 
     def run(theta: np.ndarray) -> np.ndarray:
         # a model without a compiled kernel (custom g) is integrated through its eval, in

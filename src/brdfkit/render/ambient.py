@@ -50,6 +50,7 @@ from brdfkit._cache import bounded_cache
 from brdfkit.analysis import albedo
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models import BRDF, DerivedBRDF
+from brdfkit.status import STATUS
 
 __all__ = ["AmbientTable", "ambient_table", "transposed", "RHO_TOL", "MAX_TABLE_NODES"]
 
@@ -150,18 +151,29 @@ class AmbientTable:
         error estimate at the nodes.
     tol : float
         The goal the grid was refined to.
-    success : bool
-        Whether the goal was met (and every engine angle converged).
-    message : str
-        One line: what was reached, or why not.
+    status : int
+        ``brdfkit.status.STATUS["render"]``: converged (0: the goal was met and every
+        engine angle converged) or limit (1: the error estimate is above the goal).
+    detail : str
+        One line: what was reached, or why not, with the numbers.
+    success, message : bool, str
+        The status's success; its message followed by ``detail``.
     """
 
     theta: np.ndarray
     rho: np.ndarray
     error: float
     tol: float
-    success: bool
-    message: str
+    status: int
+    detail: str
+
+    @property
+    def success(self) -> bool:
+        return STATUS["render"].success(self.status)
+
+    @property
+    def message(self) -> str:
+        return f"{STATUS['render'].message(self.status)}: {self.detail}"
 
     def __post_init__(self):
         object.__setattr__(self, "_interp", _spline(self.theta, self.rho))
@@ -289,5 +301,6 @@ def _build(target: BRDF, th_max: float, goal: float) -> AmbientTable:
     else:
         message = (f"rho(theta_V) goal {goal:g} not met within {MAX_TABLE_NODES} nodes: "
                    f"error estimate {error:.2g}")
-    return AmbientTable(theta=theta, rho=rho, error=error, tol=goal, success=met,
-                        message=message)
+    codes = STATUS["render"]
+    return AmbientTable(theta=theta, rho=rho, error=error, tol=goal,
+                        status=codes.CONVERGED if met else codes.LIMIT, detail=message)

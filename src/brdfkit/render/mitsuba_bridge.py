@@ -79,8 +79,9 @@ Public objects
   …}``: ``SPEC`` a model name or material spec (``brdfkit.model(spec,
   **params)``), per-channel values as comma-separated strings
   (``"eta": "0.2, 0.9, 1.1"``), optional ``"wavelengths": "450, 550, 650"``
-  (nm; the channels' wavelengths), ``"pump": N`` (pump N times) and
-  ``"pump_g": "max"|"controlled"``.
+  (nm; the channels' wavelengths), ``"pump": "max"|"controlled"`` and
+  ``"times": K`` — the flat form of :class:`brdfkit.spec.ModelSpec`; the old
+  ``"pump": N`` (pump N times) with ``"pump_g"`` is still read.
 
 References
 ----------
@@ -98,7 +99,6 @@ from collections.abc import Callable
 import numpy as np
 
 from brdfkit._cache import bounded_cache
-from brdfkit._specs import model as build_model
 from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
 from brdfkit.render.mitsuba_colour import ColourMap, check_wavelengths
@@ -107,6 +107,7 @@ from brdfkit.render.mitsuba_traced import traced_class, traced_supported
 from brdfkit.render.mitsuba_variants import FALLBACK, VARIANTS, select_variant
 from brdfkit.render.mitsuba_variants import import_mitsuba as _mitsuba
 from brdfkit.render.mitsuba_wavefront import wavefront, wavefront_class
+from brdfkit.spec import model as build_model
 
 __all__ = ["FALLBACK", "ROUTES", "VARIANTS", "mitsuba_bsdf", "spectral_model", "use_variant",
            "wavefront"]

@@ -6,7 +6,9 @@ The ``brdfkit`` scene-dict plugin of the Mitsuba bridge
 dict: ``SPEC`` a model name or material spec (``brdfkit.model(spec,
 **params)``), per-channel values as comma-separated strings (``"eta": "0.2,
 0.9, 1.1"``), optional ``"wavelengths": "450, 550, 650"`` (nm; the channels'
-wavelengths), ``"pump": N`` (pump N times) and ``"pump_g": "max"|"controlled"``.
+wavelengths), ``"pump": "max"|"controlled"`` and ``"times": K`` — the flat form of
+:class:`brdfkit.spec.ModelSpec` (:meth:`~brdfkit.spec.ModelSpec.from_properties`); the old
+``"pump": N`` (pump N times) with ``"pump_g"`` is still read.
 The plugin takes the route "auto" (:func:`brdfkit.render.mitsuba_bridge.mitsuba_bsdf`).
 
 Public objects
@@ -22,11 +24,10 @@ from collections.abc import Callable
 import numpy as np
 
 from brdfkit._cache import bounded_cache
-from brdfkit._specs import model as build_model
 from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
-from brdfkit.pumping import pump
 from brdfkit.render.mitsuba_variants import VARIANTS, import_mitsuba
+from brdfkit.spec import ModelSpec
 
 __all__ = ["register_plugin"]
 
@@ -34,45 +35,38 @@ __all__ = ["register_plugin"]
 _REGISTERED = bounded_cache("brdfkit.render.mitsuba_plugin._REGISTERED", maxsize=len(VARIANTS))
 
 
-def _parse_value(name: str, value):
-    """A property value: numbers as given, "a, b, c" strings as float lists."""
+def _model_from_props(props) -> tuple[BRDF, list | None]:
+    """(model, wavelengths) from a scene dict's ``{"type": "brdfkit", …}`` properties:
+    the spec's flat form (:meth:`brdfkit.spec.ModelSpec.from_properties`) plus
+    ``wavelengths``. The old ``"pump": N`` (a number: pump N times) with ``"pump_g"``
+    is read as ``"pump": pump_g, "times": N``."""
+    keys = [k for k in props.keys() if k not in ("id", "wavelengths")]
+    flat = {k: props[k] for k in keys}
+    old = flat.get("pump")
+    numeric = isinstance(old, int | float) and not isinstance(old, bool)
+    if numeric or "pump_g" in flat:  # the old form: a number of times, g apart
+        if "times" in flat or not (numeric or old is None):
+            raise ParameterError(
+                'brdfkit plugin: give "pump": "max"|"controlled" with "times": K, or the old '
+                f'"pump": N with "pump_g", not both; got pump={old!r}, '
+                f'pump_g={flat.get("pump_g")!r}, times={flat.get("times")!r}')
+        g, n = flat.pop("pump_g", "max"), int(old or 0)
+        flat.update(pump=g if n else None, times=n if n else None)
+    wavelengths = (np.atleast_1d(np.asarray(_list(props["wavelengths"]), dtype=np.float64))
+                   if "wavelengths" in props.keys() else None)
+    return ModelSpec.from_properties(flat).build(), wavelengths
+
+
+def _list(value):
+    """A property value "a, b, c" (a string) as floats; anything else as given."""
     if isinstance(value, str) and "," in value:
         try:
             return [float(x) for x in value.split(",")]
         except ValueError:
             raise ParameterError(
-                f"brdfkit plugin: property {name!r} must be a number, a word or a "
-                f"comma-separated list of numbers; got {value!r}") from None
+                f"brdfkit plugin: property 'wavelengths' must be a number or a comma-separated "
+                f"list of numbers; got {value!r}") from None
     return value
-
-
-def _model_from_props(props) -> tuple[BRDF, list | None]:
-    """(model, wavelengths) from a scene dict's ``{"type": "brdfkit", …}`` properties."""
-    if "model" not in props:
-        raise ParameterError(
-            'brdfkit plugin: property "model" is required (a model name such as '
-            '"modified-phong" or a material spec such as "merl:nickel")')
-    spec = str(props["model"])
-    params: dict = {}
-    wavelengths = None
-    times = 0
-    g = "max"
-    for key in props.keys():
-        value = _parse_value(key, props[key])
-        if key in ("model", "id"):
-            continue
-        if key == "wavelengths":
-            wavelengths = np.atleast_1d(np.asarray(value, dtype=np.float64))
-        elif key == "pump":
-            times = int(value)
-        elif key == "pump_g":
-            g = str(value)
-        else:
-            params[key] = value
-    m = build_model(spec, **params)
-    if times:
-        m = pump(m, g, times=times)
-    return m, wavelengths
 
 
 def register_plugin(variant: str, make_bsdf: Callable) -> None:

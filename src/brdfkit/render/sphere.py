@@ -31,7 +31,9 @@ nothing to the direct term, and its specular albedo to ρ(V).
 
 Public objects
 --------------
-- :func:`render_sphere` → :class:`SphereRender`.
+- :func:`render_sphere` → :class:`SphereRender` (with its error and a ``status`` of
+  ``brdfkit.status.STATUS["render"]``: the direct engine states the ambient term's error,
+  the Monte-Carlo engine the per-pixel standard error of K independent passes).
 - :func:`sphere_geometry` — pixel centres, disc mask, normals.
 
 References
@@ -51,6 +53,7 @@ from brdfkit._cache import bounded_cache, memo
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models import BRDF
 from brdfkit.render.ambient import RHO_TOL, ambient_table
+from brdfkit.status import STATUS
 
 __all__ = ["SphereRender", "render_sphere", "sphere_geometry", "exposure_phi0", "MAX_SIZE",
            "ENGINES"]
@@ -61,6 +64,7 @@ MAX_SIZE = 8192
 ENGINES = ("direct", "mitsuba")
 #: Default samples per pixel of the Monte-Carlo engine.
 DEFAULT_SPP = 64
+_CODES = STATUS["render"]
 
 
 @dataclass(frozen=True)
@@ -91,8 +95,18 @@ class SphereRender:
         (0 when L_a = 0); the direct term is exact to rounding.
     ambient_message : str
         The ρ table's accuracy statement (empty when L_a = 0).
-    success : bool
-        Whether the ρ table met its goal.
+    status : int
+        ``STATUS["render"]``: converged (0: every term within its stated error), limit
+        (1: the ρ table missed its goal; its error estimate is stated), undetermined (2:
+        one Monte-Carlo pass, no standard error), nonfinite (3: NaN or inf radiance).
+    mc_error : ndarray (S, S, C) or None
+        The Monte-Carlo engine's per-pixel standard error of the radiance (1σ, from
+        ``passes`` independent passes; :mod:`brdfkit.render.mitsuba_sphere`); None for
+        the direct engine (no sampling) and for one pass.
+    passes : int or None
+        The Monte-Carlo engine's passes (None for direct).
+    success, message
+        The status's success; its message with what was reached.
     """
 
     radiance: np.ndarray
@@ -104,9 +118,27 @@ class SphereRender:
     engine: str = "direct"
     ambient_error: float = 0.0
     ambient_message: str = ""
-    success: bool = True
+    status: int = 0
     spp: int | None = None
     seed: int | None = None
+    mc_error: np.ndarray | None = None
+    passes: int | None = None
+
+    @property
+    def success(self) -> bool:
+        return _CODES.success(self.status)
+
+    @property
+    def message(self) -> str:
+        text = _CODES.message(self.status)
+        return f"{text}: {self.ambient_message}" if self.ambient_message else text
+
+    @property
+    def mc_error_max(self) -> float | None:
+        """Largest per-pixel standard error over the disc (None without one)."""
+        if self.mc_error is None:
+            return None
+        return float(np.max(self.mc_error[self.mask])) if np.any(self.mask) else 0.0
 
     @property
     def size(self) -> int:
@@ -124,7 +156,9 @@ class SphereRender:
                 "channels": int(self.radiance.shape[2]), "engine": self.engine,
                 "ambient_error": self.ambient_error, "ambient_message": self.ambient_message,
                 "success": self.success, "peak": self.peak, "spp": self.spp,
-                "seed": self.seed}
+                "seed": self.seed, "status": int(self.status), "message": self.message,
+                **({} if self.engine == "direct" else
+                   {"passes": self.passes, "mc_error_max": self.mc_error_max})}
 
 
 @numba.njit(cache=True, inline="always")
@@ -285,7 +319,7 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
                   ambient: float = 0.0, irradiance: float = 1.0,
                   size: int = 256, engine: str = "direct", spp: int | None = None,
                   seed: int = 0, variant: str = "llvm_ad_rgb",
-                  rho_tol: float = RHO_TOL) -> SphereRender:
+                  rho_tol: float = RHO_TOL, passes: int | None = None) -> SphereRender:
     """Render Lewis's sphere test configuration exactly.
 
     Parameters
@@ -311,9 +345,12 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
         Carlo through Mitsuba 3 with brdfkit's own sampler
         (:func:`brdfkit.render.mitsuba_sphere.render_sphere_mitsuba`): pixel-area
         averages that agree with ``direct`` within noise away from the rim.
-    spp, seed, variant : keyword-only
-        Samples per pixel (default :data:`DEFAULT_SPP`), seed and Mitsuba variant of
-        the ``mitsuba`` engine; ``direct`` takes no samples (``spp`` must be None).
+    spp, seed, variant, passes : keyword-only
+        Samples per pixel (default :data:`DEFAULT_SPP`), seed, Mitsuba variant and
+        independent passes (default
+        :data:`~brdfkit.render.mitsuba_sphere.DEFAULT_PASSES`; they give the per-pixel
+        standard error ``mc_error``) of the ``mitsuba`` engine; ``direct`` takes no
+        samples (``spp`` and ``passes`` must be None).
     rho_tol : float, keyword-only
         Accuracy goal of ρ(V) when L_a > 0 (see
         :func:`brdfkit.render.ambient.ambient_table`; cached per model).
@@ -321,8 +358,9 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
     Returns
     -------
     SphereRender
-        ``radiance`` (S, S, C), ``mask``, the inputs and the ambient term's
-        error estimate.
+        ``radiance`` (S, S, C), ``mask``, the inputs, the ambient term's
+        error estimate (direct) or the per-pixel standard error (mitsuba), and the
+        status.
 
     Examples
     --------
@@ -348,22 +386,30 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
     S = _check_size(size)
     C = model.n_channels or 1
     if engine == "mitsuba":
-        from brdfkit.render.mitsuba_sphere import render_sphere_mitsuba
+        from brdfkit.render.mitsuba_sphere import render_sphere_mitsuba_passes
 
         if light_azimuth != 0.0:
             raise ParameterError("light_azimuth is not supported by the mitsuba engine; "
                                  "use engine='direct'")
         n = DEFAULT_SPP if spp is None else spp
-        rad = render_sphere_mitsuba(model, phi_l=phi, ambient=L_a, irradiance=E, size=S,
-                                    spp=n, seed=seed, variant=variant)
+        rad, se, k = render_sphere_mitsuba_passes(model, phi_l=phi, ambient=L_a,
+                                                  irradiance=E, size=S, spp=n, seed=seed,
+                                                  passes=passes, variant=variant)
         _, mask = _disc(S)
+        msg = "Monte Carlo: pixel-area averages, noise ~ 1/sqrt(spp)"
+        if se is not None:
+            msg += (f"; standard error up to {float(np.max(se[mask], initial=0.0)):.3g} "
+                    f"per pixel ({k} passes)")
+        status = (_CODES.NONFINITE if not np.all(np.isfinite(rad))
+                  else _CODES.UNDETERMINED if se is None else _CODES.CONVERGED)
         return SphereRender(radiance=np.asarray(rad, dtype=np.float64), mask=mask,
                             model=model.to_dict(), phi_l=phi, ambient=L_a, irradiance=E,
                             engine="mitsuba", spp=int(n), seed=int(seed),
-                            ambient_message="Monte Carlo: pixel-area averages, noise ~ 1/sqrt(spp)")
-    if spp is not None:
-        raise ParameterError(f"spp={spp!r}: the direct engine is exact and takes no samples; "
-                             "drop spp or use engine='mitsuba'")
+                            ambient_message=msg, status=status, mc_error=se, passes=k)
+    if spp is not None or passes is not None:
+        name, value = ("spp", spp) if spp is not None else ("passes", passes)
+        raise ParameterError(f"{name}={value!r}: the direct engine is exact and takes no "
+                             f"samples; drop {name} or use engine='mitsuba'")
     psi = float(light_azimuth)
     if not math.isfinite(psi):
         raise ParameterError(f"light_azimuth must be a finite angle in radians; got "
@@ -375,7 +421,7 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
         theta_max = max(math.acos(math.sqrt(max(1.0 - _max_r2(S), 0.0))), 1e-3)
         table = ambient_table(model, theta_max=theta_max, tol=rho_tol)
         out = L_a * _rho_image(table, S, C)
-        err, msg, ok = L_a * table.error, table.message, table.success
+        err, msg, ok = L_a * table.error, table.detail, table.success
     else:
         out = np.zeros((S * S, C))
     if E > 0.0 and model.kernel is not None:
@@ -390,9 +436,11 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
             f = np.asarray(model.eval(wi[:k], wo[:k]), dtype=np.float64).reshape(k, C)
             _scatter(out, index[:k], E * cos_l[:k], np.ascontiguousarray(f))
     _, mask = _disc(S)
+    status = (_CODES.NONFINITE if not np.all(np.isfinite(out))
+              else _CODES.CONVERGED if ok else _CODES.LIMIT)
     return SphereRender(radiance=out.reshape(S, S, C), mask=mask, model=model.to_dict(),
                         phi_l=phi, ambient=L_a, irradiance=E, engine="direct",
-                        ambient_error=err, ambient_message=msg, success=ok)
+                        ambient_error=err, ambient_message=msg, status=status)
 
 
 def exposure_phi0(model: BRDF, *, ambient: float = 0.0, irradiance: float = 1.0,

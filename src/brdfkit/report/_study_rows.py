@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 import math
 
-from brdfkit.fitting.procedure import STATUS_MESSAGES
+from brdfkit.status import STATUS
 
 
 def _f(x) -> float:
@@ -39,7 +39,7 @@ def _fit_status(row) -> int:
         return int(s)
     # rows written before fit_status existed: read the message
     msg = str(row.get("message", ""))
-    for code, text in STATUS_MESSAGES.items():
+    for code, text in STATUS["fit"].messages.items():
         if msg.startswith(text):
             return code
     return -1

@@ -31,12 +31,12 @@ def alpha_figure(study, path):
 
     fig, ax = plt.subplots(figsize=(6.0, 3.4), layout="constrained")
     bins = np.linspace(0.0, 1.0, 11)
-    for loss, colour in (("l1", "C0"), ("l2", "C1")):
+    for loss, colour, histtype, opacity in (("l1", "C0", "stepfilled", 0.5),
+                                            ("l2", "C1", "step", 1.0)):
         a = [_params(r).get("alpha") for r in study.get(("nielsen", f"alpha-mix-{loss}"), [])
              if _ok(r)]
         a = [x for x in a if x is not None]
-        ax.hist(a, bins=bins, histtype="step" if loss == "l2" else "stepfilled",
-                alpha=1.0 if loss == "l2" else 0.5, color=colour, lw=1.5,
+        ax.hist(a, bins=bins, histtype=histtype, alpha=opacity, color=colour, lw=1.5,
                 label=f"{loss.upper()} fits ({len(a)})")
     from matplotlib.ticker import MaxNLocator
 
@@ -54,6 +54,7 @@ def fig1_figure(study, path, theta_i=(30.0, 60.0)):
     from matplotlib.ticker import NullFormatter
 
     import brdfkit
+    from brdfkit.spec import ModelSpec
 
     l1 = _by_target(study.get(("nielsen", "alpha-mix-l1"), []))
     l2 = _by_target(study.get(("nielsen", "alpha-mix-l2"), []))
@@ -65,8 +66,8 @@ def fig1_figure(study, path, theta_i=(30.0, 60.0)):
                              layout="constrained")
     for j, t in enumerate(mats):
         target = brdfkit.data.material(t)
-        m1 = brdfkit.model("nielsen", **_params(l1[t]))
-        m2 = brdfkit.model("nielsen", **_params(l2[t]))
+        m1, m2 = (ModelSpec.from_dict({"model": "nielsen", "params": _params(r[t])}).build()
+                  for r in (l1, l2))
         for i, ti in enumerate(theta_i):
             ax = axes[i, j]
             y = in_plane_slice(target, ti, th)

@@ -37,27 +37,54 @@ samples (weights w_j) and over the albedo angles θ_t (equal weights); the
 two are combined by the same power mean S_p(A, B) = ((A^p + B^p)/2)^{1/p}.
 The albedos a_m, a_t are integrated with
 :func:`brdfkit.fitting.samples.albedo_nodes` (θ_t = 0°, 10°, …, 80°).
+
+Losses as objects
+-----------------
+Each loss is one small class in its own module (:class:`~brdfkit.fitting.losses._base.Loss`:
+its value, its sample mask, its linear solve, whether that solve makes variable
+projection exact, whether it needs albedos), listed once in :data:`REGISTRY`;
+:func:`loss` is the dispatcher, whose error lists the names. A new loss is one module
+here and one entry in :data:`REGISTRY` (``docs/architecture.md``, "How to add a loss").
+
+Public objects
+--------------
+- :data:`REGISTRY` — name → :class:`Loss` instance, in the order metrics are reported.
+- :data:`LOSSES` — the names (the CLI's ``--loss`` choices).
+- :func:`loss` — the dispatcher.
+- :func:`loss_value` — the value of a loss given by name.
+- :class:`Loss` and the losses :class:`L1`, :class:`L2`, :class:`Ngan`, :class:`Log`,
+  :class:`Perceptual`; constants :data:`P_SMOOTH`, :data:`TAU_REL`,
+  :data:`NGAN_THETA_MAX_DEG`.
 """
 
 from __future__ import annotations
 
-import numpy as np
+from brdfkit.errors import ParameterError
+from brdfkit.fitting.losses._base import Loss
+from brdfkit.fitting.losses.l1 import L1
+from brdfkit.fitting.losses.l2 import L2
+from brdfkit.fitting.losses.log import Log
+from brdfkit.fitting.losses.ngan import NGAN_THETA_MAX_DEG, Ngan
+from brdfkit.fitting.losses.perceptual import P_SMOOTH, TAU_REL, Perceptual
 
-__all__ = ["LOSSES", "loss_value", "P_SMOOTH", "TAU_REL", "NGAN_THETA_MAX_DEG"]
+__all__ = ["REGISTRY", "LOSSES", "loss", "loss_value", "Loss", "L1", "L2", "Ngan", "Log",
+           "Perceptual", "P_SMOOTH", "TAU_REL", "NGAN_THETA_MAX_DEG"]
 
+#: Every loss, by name, in the order metrics are reported.
+REGISTRY: dict[str, Loss] = {L.name: L() for L in (L1, L2, Ngan, Log, Perceptual)}
 #: Loss names, in the order metrics are reported.
-LOSSES = ("l1", "l2", "ngan", "log", "perceptual")
-#: Power of the smooth maximum of the perceptual loss.
-P_SMOOTH = 8.0
-#: Floor of the perceptual relative error, as a fraction of the channel's mean y.
-TAU_REL = 1e-2
-#: Ngan et al.'s cut-off of θ_i and θ_o, degrees.
-NGAN_THETA_MAX_DEG = 80.0
+LOSSES = tuple(REGISTRY)
 
 
-def _power_mean(e, w, p=P_SMOOTH):
-    s = np.sum(w * e ** p) / np.sum(w)
-    return float(s ** (1.0 / p))
+def loss(name) -> Loss:
+    """The loss *name* (a :class:`Loss` is returned as it is); the error lists the names."""
+    if isinstance(name, Loss):
+        return name
+    try:
+        return REGISTRY[name]
+    except (KeyError, TypeError):
+        raise ParameterError(f"fit: loss must be one of {', '.join(LOSSES)}; got "
+                             f"{name!r}") from None
 
 
 def loss_value(name: str, m, y, w, *, ngan_mask=None, albedo_m=None, albedo_t=None) -> float:
@@ -70,33 +97,8 @@ def loss_value(name: str, m, y, w, *, ngan_mask=None, albedo_m=None, albedo_t=No
     w : ndarray (N,)
         Sample measures.
     ngan_mask : ndarray (N,) of bool
-        Samples with θ_i, θ_o ≤ 80° (``ngan`` only).
+        The loss's sample mask (:meth:`Loss.sample_mask`; ``ngan``: θ_i, θ_o ≤ 80°).
     albedo_m, albedo_t : ndarray (T, C)
         Albedos of model and target (``perceptual`` only).
     """
-    if name == "l1":
-        return float(np.sum(w[:, None] * np.abs(m - y)) / (np.sum(w) * y.shape[1]))
-    if name == "l2":
-        return float(np.sum(w[:, None] * (m - y) ** 2) / (np.sum(w) * y.shape[1]))
-    if name == "ngan":
-        k = ngan_mask
-        d = m[k] - y[k]
-        # a search step to an extreme lobe (values ~1e160) squares to inf: the loss is then
-        # inf, which the optimiser rejects; no warning for it
-        with np.errstate(over="ignore"):
-            return float(np.sqrt(np.sum(w[k, None] * d * d) / (np.sum(w[k]) * y.shape[1])))
-    if name == "log":
-        # log1p of a negative m (a model below 0 is not a BRDF): clamped at 0 so the loss
-        # stays finite; no registered model goes below 0
-        d = np.log1p(np.maximum(m, 0.0)) - np.log1p(np.maximum(y, 0.0))
-        return float(np.sum(w[:, None] * d * d) / (np.sum(w) * y.shape[1]))
-    if name == "perceptual":
-        tau = TAU_REL * (w @ y) / np.sum(w)  # per channel
-        # both clamped at 0 before the floor: the log ratio of a negative value is undefined
-        e_f = np.abs(np.log((np.maximum(m, 0.0) + tau) / (np.maximum(y, 0.0) + tau)))
-        ef = _power_mean(e_f, w[:, None] * np.ones_like(e_f))
-        tiny = 1e-12  # an albedo of exactly 0 (a black model) has an infinite log ratio
-        e_a = np.abs(np.log(np.maximum(albedo_m, tiny) / np.maximum(albedo_t, tiny)))
-        ea = _power_mean(e_a, np.ones_like(e_a))
-        return float((0.5 * (ef ** P_SMOOTH + ea ** P_SMOOTH)) ** (1.0 / P_SMOOTH))
-    raise ValueError(name)  # unreachable: names are validated by fit()
+    return loss(name).value(m, y, w, mask=ngan_mask, albedo_m=albedo_m, albedo_t=albedo_t)

@@ -1,0 +1,125 @@
+"""
+Hemispherical–hemispherical albedo ρ_hh (an outer rule over the albedo engine)
+=============================================================================
+
+ρ_hh = (1/π) ∫ a(ω_i) cos θ_i dω_i, the fraction of uniform incident radiance that is
+reflected. With μ = cos θ_i = u², ρ_hh = ∫₀¹ a(μ) 2μ dμ = ∫₀¹ 4 a(u²) u³ du, computed
+with n-point Gauss–Legendre in u (smooth even when a ∝ μ^−p near grazing) over the
+directional albedos of the one engine (:func:`brdfkit.analysis.albedo`), and the
+n/2-point rule for the error estimate.
+
+Public objects
+--------------
+- :class:`HemisphericalAlbedo` — value, error estimate, status (``brdfkit.status``, kind
+  ``hemispherical``), ``success``, ``message``.
+- :func:`hemispherical_albedo` — compute it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from brdfkit.analysis.albedo_engine import NONFINITE, _check_model, albedo
+from brdfkit.errors import ParameterError
+from brdfkit.status import STATUS
+
+__all__ = ["HemisphericalAlbedo", "hemispherical_albedo"]
+
+_CODES = STATUS["hemispherical"]
+
+
+@dataclass(frozen=True)
+class HemisphericalAlbedo:
+    """ρ_hh of one model.
+
+    Attributes
+    ----------
+    value : ndarray
+        ρ_hh: 0-d, or (C,) for coloured models.
+    error : ndarray
+        Absolute error estimate, same shape (inf when a directional albedo did not
+        converge: its estimate is not a bound).
+    n : int
+        Nodes of the outer Gauss–Legendre rule.
+    status : int
+        ``STATUS["hemispherical"]``: converged (0), limit (1: a directional albedo did
+        not converge), nonfinite (3: a directional albedo is NaN).
+    detail : str
+        The engine's message when it did not converge (empty otherwise).
+    """
+
+    value: np.ndarray
+    error: np.ndarray
+    n: int
+    status: int = 0
+    detail: str = ""
+
+    @property
+    def success(self) -> bool:
+        return _CODES.success(self.status)
+
+    @property
+    def message(self) -> str:
+        """The status table's message, with the engine's when it did not converge."""
+        text = _CODES.message(self.status)
+        return f"{text}: {self.detail}" if self.detail else text
+
+    def to_dict(self) -> dict:
+        """JSON-ready: value and error (lists when coloured), n, status, success, message."""
+        return {"value": np.asarray(self.value).tolist(),
+                "error": np.asarray(self.error).tolist(), "n": self.n,
+                "status": int(self.status), "success": self.success, "message": self.message}
+
+
+def hemispherical_albedo(model, *, n: int = 48, tol: float = 1e-7) -> HemisphericalAlbedo:
+    """Hemispherical–hemispherical albedo ρ_hh = (1/π) ∫ a(ω_i) cos θ_i dω_i.
+
+    With μ = cos θ_i = u², ρ_hh = ∫₀¹ a(μ) 2μ dμ = ∫₀¹ 4 a(u²) u³ du, computed with
+    n-point Gauss–Legendre in u (smooth even when a ∝ μ^−p near grazing), and the
+    n/2-point rule for the error estimate.
+
+    Parameters
+    ----------
+    model : BRDF or callable
+    n : int, keyword-only
+        Nodes of the outer rule, in [2, 1000].
+    tol : float, keyword-only
+        Accuracy goal of each directional albedo.
+
+    Returns
+    -------
+    HemisphericalAlbedo
+        ``value`` and ``error`` (scalars or (C,) for coloured models); the error is
+        |n-point − n/2-point| plus the weighted engine errors, infinite when an albedo
+        did not converge (``status`` limit, or nonfinite when it is NaN).
+    """
+    _check_model(model, "hemispherical_albedo")
+    if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 2 <= n <= 1000:
+        # the n/2-point rule gives the error estimate, so n >= 2; 1000 nodes: far beyond the
+        # accuracy of the albedo itself (a is smooth in u = sqrt(cos theta_i))
+        raise ParameterError(f"hemispherical_albedo: n must be an integer in [2, 1000]; "
+                             f"got {n!r}")
+    x, w = np.polynomial.legendre.leggauss(int(n))
+    x2, w2 = np.polynomial.legendre.leggauss(int(n) // 2)
+    us = np.concatenate([(x + 1) / 2, (x2 + 1) / 2])
+    th = np.arccos(np.clip(us * us, 0.0, 1.0))
+    th = np.minimum(th, math.pi / 2 - 1e-12)  # the node nearest grazing stays inside [0, π/2)
+    r = albedo(model, th, tol=tol)
+    a = np.asarray(r.albedo)
+    wt = 4.0 * us ** 3
+    wt = wt.reshape(wt.shape + (1,) * (a.ndim - 1))
+    aw = a * wt
+    v1 = np.tensordot(w / 2, aw[: len(x)], axes=(0, 0))
+    v2 = np.tensordot(w2 / 2, aw[len(x):], axes=(0, 0))
+    ew = np.asarray(r.error)[: len(x)] * wt[: len(x)]
+    err = np.abs(v1 - v2) + np.tensordot(w / 2, ew, axes=(0, 0))
+    status, detail = _CODES.CONVERGED, ""
+    if not r.success:  # an unconverged angle's estimate is not a bound
+        err = np.full_like(err, np.inf)
+        status = _CODES.NONFINITE if np.any(r.status == NONFINITE) else _CODES.LIMIT
+        detail = r.message
+    return HemisphericalAlbedo(value=v1, error=err, n=int(n), status=int(status),
+                               detail=detail)

@@ -1,0 +1,628 @@
+"""
+The model spec: what to build, its parameters, the operators applied to it
+==========================================================================
+
+One immutable value, :class:`ModelSpec`, says which model to build, with which
+parameters and which operators applied to it in order. Every place that builds
+a model from words (the command line's ``MODEL -p NAME=VALUE --pump G --times
+K``, the Mitsuba plugin's properties) or from a dict (``model.to_dict()``, the
+explorer's state entries, the fitting batches' jobs and the study's rows) goes
+through it, so a model is described one way everywhere:
+
+- :meth:`ModelSpec.parse` — from the command line's words;
+- :meth:`ModelSpec.from_dict` / :meth:`ModelSpec.to_dict` — the JSON form that
+  ``model.to_dict()`` produces, ``{"model": NAME, "params": {...},
+  "pump": {"g": G, "times": K}}`` (a list of such for stages with different g);
+- :meth:`ModelSpec.from_properties` — a flat property list (the Mitsuba plugin:
+  ``{"model": NAME, "pump": G, "times": K, PARAM: VALUE, …}``);
+- :meth:`ModelSpec.of` — the spec of a built model (``of(m).build()`` has
+  ``m``'s values);
+- :meth:`ModelSpec.build` — the model.
+
+What to build (:data:`KINDS`, the first kind that claims the name builds it)
+--------------------------------------------------------------------------
+======================================  =================================================
+written as                              built
+======================================  =================================================
+``merl:NAME[@nbrdf|npf|abc|sgd]``,      a built-in measured material
+``rgl:NAME``, ``nielsen:NAME``          (:func:`brdfkit.data.material`); no parameters
+``PATH.binary`` or an ``os.PathLike``   a MERL file as a :class:`~brdfkit.data.MeasuredBRDF`
+                                        (parameter ``lookup``)
+``modified-phong`` (a registered name   the analytic model (:data:`brdfkit.MODELS`)
+or alias; anything else)
+======================================  =================================================
+
+Operators (:data:`OPERATORS`, applied in the order given)
+---------------------------------------------------------
+========  ===========================  ==============================================
+key       arguments                    operator
+========  ===========================  ==============================================
+``pump``  ``g`` (``max``,              :func:`brdfkit.pumping.pump` (Neumann et al.
+          ``controlled``), ``times``   1999, eqs. 16–21)
+          (1 … :data:`MAX_TIMES`)
+========  ===========================  ==============================================
+
+A half-angle ``beta`` among the parameters (degrees on the command line,
+radians in a dict) is resolved once, when the spec is made, into the model's
+width parameter (``n``, ``alpha``, ``m`` … as the model and its distribution
+say): a spec's parameters are always the model's own.
+
+An unknown name raises :class:`~brdfkit.errors.UnknownModelError` listing the
+valid model names and the material-spec forms, with did-you-mean hints for
+both (``nickel`` → ``merl:nickel``).
+
+This module is the package root's (layer 2 in ``docs/architecture.md``, with
+``data`` and ``pumping``, whose operator it applies); ``docs/architecture.md``,
+"Model spec", says how to add a kind or an operator.
+
+Public objects
+--------------
+- :class:`ModelSpec`, :class:`Operator` — the spec and one applied operator.
+- :func:`model` — build a model or a material from its name (``brdfkit.model``).
+- :func:`model_params` — the parameter declarations a name accepts.
+- :func:`canonical_name` — a name's canonical name.
+- :func:`parse_items` — ``NAME=VALUE`` words → parameter values.
+- :func:`times_problem` — why a number of pumpings is invalid, or None.
+- :func:`is_material_spec` — whether a name is a material spec.
+- :data:`KINDS`, :class:`SpecKind`; :data:`OPERATORS`, :class:`OperatorKind`.
+- :data:`SPEC_FORMS`, :data:`PUMP_CHOICES`, :data:`MAX_TIMES`, :data:`TIMES_REASON`.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from brdfkit.data.catalog import (
+    MATERIAL_SOURCES,
+    is_material_spec,
+    material,
+    suggest_material_specs,
+)
+from brdfkit.errors import BrdfkitError, ParameterError, UnknownModelError
+from brdfkit.models import BRDF, resolve
+from brdfkit.pumping import G_CHOICES, MAX_TIMES, pump
+
+__all__ = ["ModelSpec", "Operator", "model", "model_params", "canonical_name", "parse_items",
+           "times_problem", "is_material_spec", "KINDS", "SpecKind", "OPERATORS",
+           "OperatorKind", "SPEC_FORMS", "PUMP_CHOICES", "MAX_TIMES", "TIMES_REASON"]
+
+#: How a material spec is written (for error messages and help texts).
+SPEC_FORMS = ("merl:NAME[@nbrdf|@npf|@abc|@sgd], rgl:NAME, nielsen:NAME or a path to a "
+              "MERL .binary file ('brdfkit materials' lists the built-in ones)")
+#: The built-in g of the pump operator (:data:`brdfkit.pumping.G_CHOICES`).
+PUMP_CHOICES = tuple(G_CHOICES)
+#: Why the number of pumpings is bounded (:data:`MAX_TIMES`), for messages and help.
+TIMES_REASON = ("each pumping tabulates the previous stage's albedo, so the cost grows with "
+                "the number of stages: times=8 takes about a minute")
+
+
+# --------------------------------------------------------------------------- what to build
+@dataclass(frozen=True)
+class SpecKind:
+    """One kind of thing a spec builds.
+
+    ``claims(name)`` says whether a name is of this kind; ``resolve(name)`` gives
+    a template with ``.name`` (canonical) and ``.params`` (declarations) — a model
+    class or a model object — and ``build(template, params)`` the model.
+    """
+
+    name: str
+    form: str
+    claims: Callable[[object], bool]
+    resolve: Callable[[object], object]
+    build: Callable[[object, dict], BRDF]
+
+
+def _unknown(name, err: UnknownModelError) -> UnknownModelError:
+    hints = suggest_material_specs(str(name))
+    hint = (" (did you mean the material " + " or ".join(repr(h) for h in hints) + "?)"
+            if hints else "")
+    return UnknownModelError(f"{err}{hint}; or a material spec: {SPEC_FORMS}")
+
+
+def _registered(name):
+    try:
+        return resolve(name)
+    except UnknownModelError as err:
+        raise _unknown(name, err) from None
+
+
+def _is_builtin(name) -> bool:
+    source, sep, _ = str(name).strip().partition(":") if isinstance(name, str) else ("", "", "")
+    return bool(sep) and source.lower() in MATERIAL_SOURCES
+
+
+def _is_merl_file(name) -> bool:
+    if isinstance(name, os.PathLike):
+        return True
+    s = str(name).strip().lower() if isinstance(name, str) else ""
+    return s.endswith(".binary") or s.startswith("merl-file:")
+
+
+def _merl_file(name):
+    if isinstance(name, str) and name.strip().lower().startswith("merl-file:"):
+        raise UnknownModelError(
+            f"{name!r} names a MERL file by its base name only (what the model's to_dict "
+            "keeps); give the file's path, PATH.binary")
+    return material(name)
+
+
+def _with_params(template, params: dict):
+    return template.with_params(**params) if params else template
+
+
+#: What a spec builds, tried in order; the registered models claim every other name.
+#: A new kind (a ``.brdf`` file, a Python file's model) is one entry before the last.
+KINDS: tuple[SpecKind, ...] = (
+    SpecKind("material", "merl:NAME[@nbrdf|@npf|@abc|@sgd], rgl:NAME, nielsen:NAME",
+             _is_builtin, material, _with_params),
+    SpecKind("merl-file", "PATH.binary (a MERL file)", _is_merl_file, _merl_file, _with_params),
+    SpecKind("model", "a registered model name or alias ('brdfkit models')",
+             lambda name: True, _registered, lambda cls, params: cls(**params)),
+)
+
+
+def _kind(name) -> SpecKind:
+    return next(k for k in KINDS if k.claims(name))
+
+
+def model(name, /, **params) -> BRDF:
+    """Build the model or material called *name* (module docstring) with *params*.
+
+    Parameters
+    ----------
+    name : str or os.PathLike
+        A registered model name or alias, a built-in material spec, or a path
+        to a MERL ``.binary`` file.
+    **params
+        Parameter values (API units: ``beta`` in radians); omitted ones take
+        their defaults. Built-in materials have none; a ``.binary`` material
+        has ``lookup``.
+
+    Raises
+    ------
+    UnknownModelError
+        *name* is neither a model nor a material; the message lists both.
+    ParameterError
+        A parameter the model does not declare, or a value outside its bounds.
+    DataFileError
+        A ``.binary`` path that cannot be read.
+
+    Examples
+    --------
+    >>> import brdfkit
+    >>> m = brdfkit.model("modified-phong", rho_s=0.5, n=50)
+    >>> nickel = brdfkit.model("merl:nickel")
+    """
+    kind = _kind(name)
+    return kind.build(kind.resolve(name), params)
+
+
+def model_params(name) -> tuple:
+    """The parameter declarations (:class:`~brdfkit.Param`) *name* accepts."""
+    return tuple(_kind(name).resolve(name).params)
+
+
+def canonical_name(name) -> str:
+    """The canonical name of a registered model, or the material's own name."""
+    return _kind(name).resolve(name).name
+
+
+# --------------------------------------------------------------------------- words
+def _parse_number(text: str, name: str, label: str, bounds: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise ParameterError(
+            f"{label}: parameter {name!r} must be a number{bounds}; got {text!r}") from None
+
+
+def parse_items(name, items: Iterable[str] | Mapping, *, option: str = "-p") -> dict:
+    """``NAME=VALUE`` words (as typed after *option*) → parameter values for *name*.
+
+    Numbers; comma-separated numbers for per-channel colour or per-lobe
+    parameters; words for choice parameters; ``none`` for optional ones;
+    ``beta`` in degrees, in (0, 90), converted to radians. A mapping is taken
+    as already parsed (API units) and returned as a dict. A name the model does
+    not declare is kept as text: the model names it and lists the valid ones.
+
+    Raises
+    ------
+    UnknownModelError
+        *name* is neither a model nor a material.
+    ParameterError
+        A malformed item (naming *option*), a repeated name, or a value that is
+        not a number.
+    """
+    template = _kind(name).resolve(name)
+    label = template.name
+    if isinstance(items, Mapping):
+        return dict(items)
+    decls = {p.name: p for p in template.params}
+    out: dict = {}
+    for item in items:
+        key, sep, text = str(item).partition("=")
+        key, text = key.strip(), text.strip()
+        if not sep or not key or not text:
+            raise ParameterError(
+                f"parameter must be given as NAME=VALUE (e.g. {option} rho_d=0.5); got {item!r}")
+        if key in out:
+            raise ParameterError(f"{label}: parameter {key!r} given twice")
+        if key == "beta":
+            deg = _parse_number(text, "beta", label, " of degrees in (0, 90)")
+            if not 0.0 < deg < 90.0:
+                raise ParameterError(
+                    f"{label}: parameter 'beta' (half-angle, degrees on the command line) "
+                    f"must lie in (0, 90); got {text}")
+            out[key] = math.radians(deg)
+            continue
+        p = decls.get(key)
+        if p is None:
+            out[key] = text
+            continue
+        bounds = f" in {p.bounds_text()}"
+        if p.optional and text.lower() in ("none", "null"):
+            out[key] = None
+        elif p.kind == "choice":
+            out[key] = text
+        elif p.kind in ("colour", "lobes") and "," in text:
+            out[key] = [_parse_number(t.strip(), key, label, bounds) for t in text.split(",")]
+        else:
+            out[key] = _parse_number(text, key, label, bounds)
+    return out
+
+
+def times_problem(times) -> str | None:
+    """Why *times* is not a valid number of pumpings (without the option name), or None."""
+    try:
+        ok = not isinstance(times, bool) and int(times) == times and 1 <= times <= MAX_TIMES
+    except (TypeError, ValueError):  # not a number at all (e.g. a string through the API)
+        ok = False
+    if not ok:
+        return f"must be an integer from 1 to {MAX_TIMES}; got {times} ({TIMES_REASON})"
+    return None
+
+
+# --------------------------------------------------------------------------- operators
+@dataclass(frozen=True)
+class OperatorKind:
+    """One operator a spec can apply.
+
+    ``key`` is its name and its key in the dict form; ``stages(value, d)`` reads
+    the dict form's value (*d* is the whole dict, for flat siblings such as
+    ``times``) into argument mappings, one per operator; ``check(args)``
+    validates one and returns it in canonical form; ``apply(model, args)``
+    applies it; ``value(stages)`` writes the dict form's value; ``flat`` names
+    the sibling keys of the flat form.
+    """
+
+    key: str
+    stages: Callable[[object, Mapping], list]
+    check: Callable[[Mapping], dict]
+    apply: Callable[[BRDF, dict], BRDF]
+    value: Callable[[list], object]
+    flat: tuple = ()
+
+
+def _pump_stages(value, d: Mapping) -> list:
+    if value is None or (isinstance(value, str) and value.strip().lower() in ("", "none")):
+        return []  # a flat "times" without a pump is the page's unused field: not read
+    if isinstance(value, str):
+        times = d.get("times")
+        return [{"g": value, "times": 1 if times is None else times}]
+    if isinstance(value, Mapping):
+        return [value]
+    if isinstance(value, list | tuple) and all(isinstance(s, Mapping) for s in value):
+        return list(value)
+    raise ParameterError(f"pump must be 'max', 'controlled', none, {{'g': G, 'times': K}} or "
+                         f"a list of those; got {value!r}")
+
+
+def _pump_check(args: Mapping) -> dict:
+    unknown = sorted(set(args) - {"g", "times"})
+    if unknown:
+        raise ParameterError(f"pump: unknown argument {unknown[0]!r}; valid: g, times")
+    g = args.get("g", "max")
+    if g == "custom":
+        raise ParameterError("from_dict: a custom g cannot be rebuilt from a dict")
+    if g not in G_CHOICES:
+        raise ParameterError(f"pump must be 'max', 'controlled' or none; got {g!r}")
+    times = args.get("times", 1)
+    problem = times_problem(times)
+    if problem is not None:
+        raise ParameterError(f"times {problem}")
+    return {"g": g, "times": int(times)}
+
+
+def _pump_value(stages: list) -> object:
+    return stages[0] if len(stages) == 1 else stages
+
+
+#: The operators a spec applies, by key. Energy compensation, next, is one more entry.
+OPERATORS: dict[str, OperatorKind] = {
+    "pump": OperatorKind("pump", _pump_stages, _pump_check,
+                         lambda m, a: pump(m, a["g"], times=a["times"]), _pump_value,
+                         flat=("times",)),
+}
+
+
+@dataclass(frozen=True)
+class Operator:
+    """One operator applied to a model: ``kind`` (a key of :data:`OPERATORS`) and its
+    ``args`` as sorted ``(name, value)`` pairs (:attr:`arguments` as a dict)."""
+
+    kind: str
+    args: tuple = ()
+
+    def __post_init__(self):
+        if self.kind not in OPERATORS:
+            raise ParameterError(f"unknown operator {self.kind!r}; valid: "
+                                 + ", ".join(OPERATORS))
+        checked = OPERATORS[self.kind].check(dict(self.args))
+        object.__setattr__(self, "args", tuple(sorted(checked.items())))
+
+    @property
+    def arguments(self) -> dict:
+        return dict(self.args)
+
+
+# --------------------------------------------------------------------------- the spec
+def _freeze(v):
+    if isinstance(v, np.ndarray):
+        v = v.tolist()
+    if isinstance(v, list | tuple):
+        return tuple(_freeze(x) for x in v)
+    return v.item() if isinstance(v, np.generic) else v
+
+
+def _thaw(v):
+    return [_thaw(x) for x in v] if isinstance(v, tuple) else v
+
+
+class ModelSpec:
+    """What to build, its parameters and the operators applied to it (module docstring).
+
+    Parameters
+    ----------
+    target : str or os.PathLike
+        A registered name or alias, a material spec or a MERL file path (:data:`KINDS`).
+    params : mapping, optional
+        Parameter values in API units (``beta`` in radians is resolved into the
+        model's width parameter here, which builds the model once).
+    operators : sequence of Operator, optional
+        Applied in order by :meth:`build`.
+
+    A spec is immutable and hashable; two specs are equal when they name the
+    same target with the same parameters and operators. :attr:`params` is a
+    fresh dict (lists for per-channel values).
+
+    Examples
+    --------
+    >>> from brdfkit.spec import ModelSpec
+    >>> s = ModelSpec.parse("modified-phong", ["n=20"], pump="max", times=2)
+    >>> s.to_dict()
+    {'model': 'modified-phong', 'params': {'n': 20.0}, 'pump': {'g': 'max', 'times': 2}}
+    >>> m = s.build()
+    """
+
+    __slots__ = ("_target", "_params", "_operators")
+
+    def __init__(self, target, params: Mapping | None = None, operators: Iterable = ()):
+        if not isinstance(target, str | os.PathLike):
+            raise ParameterError(f"model must be a model name or a material spec (a string); "
+                                 f"got {type(target).__name__} {target!r}")
+        target = os.fspath(target) if isinstance(target, os.PathLike) else target.strip()
+        params = {} if params is None else params
+        if not isinstance(params, Mapping):
+            raise ParameterError(f"{target}: params must be an object NAME: VALUE; got "
+                                 f"{params!r}")
+        ops = tuple(operators)
+        bad = [o for o in ops if not isinstance(o, Operator)]
+        if bad:
+            raise ParameterError(f"{target}: operators must be Operator values; got {bad[0]!r}")
+        params = dict(params)
+        if "beta" in params:  # the half-angle → the model's own width parameter, once
+            kind = _kind(target)
+            m = kind.build(kind.resolve(target), params)
+            del params["beta"]
+            params[m.width_param] = m.values[m.width_param]
+        object.__setattr__(self, "_target", target)
+        object.__setattr__(self, "_params",
+                           tuple(sorted((str(k), _freeze(v)) for k, v in params.items())))
+        object.__setattr__(self, "_operators", ops)
+
+    def __setattr__(self, name, value):
+        raise AttributeError("a ModelSpec is immutable: use with_params or a new spec")
+
+    # --------------------------------------------------------------- accessors
+    @property
+    def target(self) -> str:
+        """The name as given (a registered name or alias, a material spec, a path)."""
+        return self._target
+
+    @property
+    def params(self) -> dict:
+        """The parameter values (a new dict; lists for per-channel/per-lobe values)."""
+        return {k: _thaw(v) for k, v in self._params}
+
+    @property
+    def operators(self) -> tuple:
+        """The operators, in the order :meth:`build` applies them."""
+        return self._operators
+
+    @property
+    def kind(self) -> str:
+        """The :data:`KINDS` entry that builds the target (``model``, ``material`` …)."""
+        return _kind(self._target).name
+
+    @property
+    def name(self) -> str:
+        """The target's canonical name (:func:`canonical_name`)."""
+        return canonical_name(self._target)
+
+    def __eq__(self, other):
+        if not isinstance(other, ModelSpec):
+            return NotImplemented
+        return (self._target, self._params, self._operators) == (
+            other._target, other._params, other._operators)
+
+    def __hash__(self):
+        return hash((self._target, self._params, self._operators))
+
+    def __repr__(self):
+        ops = "".join(f", {o.kind}({', '.join(f'{k}={v!r}' for k, v in o.args)})"
+                      for o in self._operators)
+        return f"ModelSpec({self._target!r}, {self.params!r}{ops})"
+
+    # --------------------------------------------------------------- variants
+    def with_params(self, **changes) -> ModelSpec:
+        """The same spec with some parameters changed (``beta`` resolved as usual)."""
+        params = self.params
+        if "beta" in changes:
+            params.pop(self._width_name(params), None)
+        return ModelSpec(self._target, {**params, **changes}, self._operators)
+
+    def without_operators(self) -> ModelSpec:
+        """The spec of the model the operators apply to."""
+        return ModelSpec(self._target, self.params)
+
+    def _width_name(self, params: dict) -> str | None:
+        kind = _kind(self._target)
+        return kind.build(kind.resolve(self._target), params).width_param
+
+    # --------------------------------------------------------------- build
+    def build(self) -> BRDF:
+        """The model: the target built with the parameters, then each operator applied."""
+        m = model(self._target, **self.params)
+        for op in self._operators:
+            m = OPERATORS[op.kind].apply(m, op.arguments)
+        return m
+
+    # --------------------------------------------------------------- words
+    @classmethod
+    def parse(cls, target, params: Iterable[str] | Mapping = (), pump: str | None = None,
+              times: int | None = None, *, option: str = "-p") -> ModelSpec:
+        """The spec of the command line's ``MODEL -p NAME=VALUE … --pump G --times K``.
+
+        Parameters
+        ----------
+        target : str
+            Registered name or alias, or a material spec (``merl:nickel``,
+            ``rgl:NAME``, ``nielsen:NAME``, a ``.binary`` path).
+        params : iterable of ``NAME=VALUE`` str, or mapping
+            See :func:`parse_items` (``beta`` in degrees there).
+        pump : {None, "max", "controlled"}
+            Pump the model (:func:`brdfkit.pumping.pump`) with this g.
+        times : int, optional
+            How many times to pump, 1 … :data:`MAX_TIMES` (default 1); only with *pump*.
+        option : str
+            The option the items came from, named in the error for a malformed one.
+
+        Raises
+        ------
+        BrdfkitError
+            Unknown model, bad parameter, *times* out of range, or *times*
+            given without *pump* (it would be silently ignored).
+        """
+        values = parse_items(target, params, option=option)
+        if pump is None and times is not None:
+            raise BrdfkitError(f"--times {times} needs --pump max or --pump controlled (it says "
+                               "how many times to pump); add --pump or drop --times")
+        ops = ()
+        if pump is not None:
+            times = 1 if times is None else times
+            problem = times_problem(times)
+            if problem is not None:
+                raise BrdfkitError(f"--times {problem}")
+            if pump not in G_CHOICES:
+                raise BrdfkitError(f"--pump must be one of {', '.join(G_CHOICES)}; got {pump!r}")
+            ops = (Operator("pump", (("g", pump), ("times", int(times)))),)
+        return cls(target, values, ops)
+
+    @classmethod
+    def from_properties(cls, props: Mapping, *, where: str = "brdfkit plugin") -> ModelSpec:
+        """The spec of a flat property list: ``{"model": NAME, PARAM: VALUE, …,
+        "pump": G, "times": K}`` (the Mitsuba plugin's scene-dict properties).
+
+        Values are in API units; a string with commas is a list of numbers
+        (``"eta": "0.2, 0.9, 1.1"``). *where* prefixes the errors.
+        """
+        if "model" not in props:
+            raise ParameterError(
+                f'{where}: property "model" is required (a model name such as '
+                '"modified-phong" or a material spec such as "merl:nickel")')
+        spec = {"model": str(props["model"]), "params": {}}
+        flat = {"model", *OPERATORS, *(s for o in OPERATORS.values() for s in o.flat)}
+        for key, value in props.items():
+            if key in flat:
+                spec.setdefault(key, value)
+                continue
+            if isinstance(value, str) and "," in value:
+                try:
+                    value = [float(x) for x in value.split(",")]
+                except ValueError:
+                    raise ParameterError(
+                        f"{where}: property {key!r} must be a number, a word or a "
+                        f"comma-separated list of numbers; got {value!r}") from None
+            spec["params"][key] = value
+        return cls.from_dict(spec)
+
+    # --------------------------------------------------------------- dicts
+    @classmethod
+    def from_dict(cls, d: Mapping) -> ModelSpec:
+        """The spec of the dict form (:meth:`to_dict`; what ``model.to_dict()`` gives).
+
+        ``{"model": NAME, "params": {...}}`` plus, per operator of
+        :data:`OPERATORS` in the order applied, its key: ``"pump": {"g": G,
+        "times": K}``, a list of those, or the flat ``"pump": G`` with
+        ``"times": K`` beside it (``None``/``"none"``: no pumping).
+
+        Raises
+        ------
+        ParameterError
+            Not a dict with a ``model`` key, an unknown key, or an operator's
+            bad argument (named).
+        """
+        if not isinstance(d, Mapping) or "model" not in d:
+            raise ParameterError(f"from_dict: expected a dict with a 'model' key; got {d!r}")
+        valid = ("model", "params", *OPERATORS, *(s for o in OPERATORS.values() for s in o.flat))
+        unknown = [k for k in d if k not in valid]
+        if unknown:
+            raise ParameterError(f"from_dict: unknown key {unknown[0]!r}; valid keys: "
+                                 + ", ".join(valid))
+        ops = [Operator(key, tuple(dict(stage).items()))
+               for key in d if key in OPERATORS
+               for stage in OPERATORS[key].stages(d[key], d)]
+        return cls(d["model"], d.get("params") or {}, ops)
+
+    def to_dict(self) -> dict:
+        """``{"model": target, "params": {...}}`` plus each operator's key (in order):
+        the form ``model.to_dict()`` has, which :meth:`from_dict` reads."""
+        d: dict = {"model": self._target, "params": self.params}
+        runs: list = []  # consecutive operators of one kind
+        for op in self._operators:
+            if runs and runs[-1][0] == op.kind:
+                runs[-1][1].append(op.arguments)
+            else:
+                runs.append((op.kind, [op.arguments]))
+        for kind, stages in runs:
+            if kind in d:
+                raise ParameterError(
+                    f"to_dict: the {kind} operator recurs after another operator; the dict "
+                    "form keeps one key per operator kind")
+            d[kind] = OPERATORS[kind].value(stages)
+        return d
+
+    @classmethod
+    def of(cls, built: BRDF) -> ModelSpec:
+        """The spec of a built model (from its ``to_dict()``): ``of(m).build()`` has
+        ``m``'s values, for every registered, material and pumped model."""
+        if not isinstance(built, BRDF):
+            raise ParameterError(f"ModelSpec.of: expected a brdfkit model (BRDF); got "
+                                 f"{type(built).__name__}")
+        return cls.from_dict(built.to_dict())
