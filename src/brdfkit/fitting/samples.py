@@ -251,15 +251,20 @@ def albedo_with_error(f, w, n_theta: int, n_u: int, n_phi: int):
     if n_u % k or n_phi % k:
         raise ParameterError(f"albedo_with_error: n_u and n_phi must be multiples of {k}; "
                              f"got {n_u}, {n_phi}")
-    a = albedo_from_values(f, w, n_theta)
-    f = np.where(w[:, None] > 0.0, f, 0.0)
-    terms = (f * w[:, None]).reshape(n_theta, n_u, n_phi, f.shape[1])
+    # the terms once; a as albedo_from_values computes it (the same operations, so the
+    # same values)
+    terms = np.where(w[:, None] > 0.0, f, 0.0) * w[:, None]
+    C = terms.shape[1]
+    a = terms.reshape(n_theta, -1, C).sum(axis=1)
+    t = terms.reshape(n_theta, n_u, n_phi, C)
     # the coarse cells' midpoints are fine nodes k·j + (k − 1)/2, their weights k (one
     # axis) or k² (both) times the fine ones' (du, dφ k times wider; the rest is evaluated
     # at the same node)
     mid = (k - 1) // 2
-    coarse_u = k * terms[:, mid::k, :, :].sum(axis=(1, 2))
-    coarse_phi = k * terms[:, :, mid::k, :].sum(axis=(1, 2))
-    coarse_both = (k * k) * terms[:, mid::k, mid::k, :].sum(axis=(1, 2))
+    by_u = t.sum(axis=2)  # (T, n_u, C): every φ node
+    by_u_coarse_phi = t[:, :, mid::k].sum(axis=2)  # (T, n_u, C): every k-th φ node
+    coarse_u = k * by_u[:, mid::k].sum(axis=1)
+    coarse_phi = k * by_u_coarse_phi.sum(axis=1)
+    coarse_both = (k * k) * by_u_coarse_phi[:, mid::k].sum(axis=1)
     spread = np.abs(a - coarse_u) + np.abs(a - coarse_phi) + np.abs(a - coarse_both)
     return a, np.broadcast_to(spread.max(axis=0), a.shape).copy()
