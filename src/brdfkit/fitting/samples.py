@@ -261,8 +261,12 @@ def albedo_with_error(f, w, n_theta: int, n_u: int, n_phi: int):
     # axis) or k² (both) times the fine ones' (du, dφ k times wider; the rest is evaluated
     # at the same node)
     mid = (k - 1) // 2
-    by_u = t.sum(axis=2)  # (T, n_u, C): every φ node
-    by_u_coarse_phi = t[:, :, mid::k].sum(axis=2)  # (T, n_u, C): every k-th φ node
+    # sums over φ (T, n_u, C), of every node and of every k-th, as matrix products (5×
+    # faster than sums over a middle axis; the estimate does not need their rounding)
+    every, kth = np.ones(n_phi), np.zeros(n_phi)
+    kth[mid::k] = 1.0
+    tp = t.transpose(0, 1, 3, 2)
+    by_u, by_u_coarse_phi = tp @ every, tp @ kth
     coarse_u = k * by_u[:, mid::k].sum(axis=1)
     coarse_phi = k * by_u_coarse_phi.sum(axis=1)
     coarse_both = (k * k) * by_u_coarse_phi[:, mid::k].sum(axis=1)
