@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import json
 import math
-from brdfkit.status import STATUS
 
+from brdfkit.status import STATUS
 
 
 def _f(x) -> float:
