@@ -270,3 +270,16 @@ def test_memory_bounded_for_a_pathological_integrand():
     assert err.max() < 2e-3  # still a good estimate
     assert np.all(r.error > 1e-9)  # reported as not converged: the estimate stays large
     assert np.all(err <= 5.0 * r.error + 1e-12)  # and of the right size
+
+
+@pytest.mark.parametrize("spec", ["merl:nickel", "merl:blue-acrylic", "rgl:acrylic_felt_green_rgb"])
+def test_catalog_normal_albedo_agrees_with_the_engine(spec):
+    """brdfkit.data.catalog.normal_albedo (a 1-D midpoint rule at θ_i = 0, a second
+    method) against the engine at θ_i = 0: within the 1e-4 relative it states."""
+    from brdfkit.data import catalog
+
+    m = brdfkit.model(spec)
+    r = albedo(m, 0.0, tol=1e-6)
+    assert r.success
+    a = catalog.normal_albedo(m)
+    np.testing.assert_allclose(a, r.albedo, rtol=1e-4)
