@@ -98,7 +98,6 @@ from collections.abc import Callable
 
 import numpy as np
 
-from brdfkit.spec import model as build_model
 from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
 from brdfkit.render.mitsuba_colour import ColourMap, check_wavelengths
@@ -107,6 +106,7 @@ from brdfkit.render.mitsuba_traced import traced_class, traced_supported
 from brdfkit.render.mitsuba_variants import FALLBACK, VARIANTS, select_variant
 from brdfkit.render.mitsuba_variants import import_mitsuba as _mitsuba
 from brdfkit.render.mitsuba_wavefront import wavefront, wavefront_class
+from brdfkit.spec import model as build_model
 
 __all__ = ["FALLBACK", "ROUTES", "VARIANTS", "mitsuba_bsdf", "spectral_model", "use_variant",
            "wavefront"]
