@@ -13,6 +13,7 @@ in five halvings, a sampler whose pdf integrates to 1.25 is rejected.
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -20,6 +21,7 @@ import pytest
 import brdfkit
 from brdfkit.analysis import H_s, albedo, albedo_mc, check, hemispherical_albedo
 from brdfkit.analysis.chi2 import chi2_test
+from brdfkit.analysis.lewis_table2 import table2
 from brdfkit.models import DerivedBRDF
 from brdfkit.status import STATUS
 
@@ -154,6 +156,8 @@ CASES = [
     ("verdict", "converged", lambda mp: check(brdfkit.model("lambert", rho_d=0.5))),
     ("verdict", "undetermined", _verdict_undetermined),
     ("verdict", "nonfinite", lambda mp: check(_nan_model())),
+    # Table 2 rows are verdicts (dicts): the same three keys
+    ("verdict", "converged", lambda mp: SimpleNamespace(**table2(models=["lambert"])[0])),
     # Chi2Result
     ("chi2", "converged", lambda mp: chi2_test(brdfkit.model("lambert", rho_d=0.5),
                                                [0.0, 0.0, 1.0], n_samples=20_000, seed=1)),

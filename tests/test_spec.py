@@ -286,3 +286,24 @@ def test_batch_jobs_and_explorer_entries_are_specs():
     assert entry_spec(entry) == want
     assert entry_spec({"spec": "modified-phong", "params": {"beta": 30}, "pump": None,
                        "times": 1}) == ModelSpec.parse("modified-phong", ["beta=30"])
+
+
+def test_mitsuba_plugin_properties_are_the_spec_vocabulary():
+    """The plugin's properties: "pump" is g and "times" K, as everywhere; the old "pump": N
+    (N times) with "pump_g" is still read, and mixing the two forms is one clear error."""
+    from brdfkit.render.mitsuba_plugin import _model_from_props
+
+    wi, wo = _pairs(10)
+    new, lam = _model_from_props({"model": "modified-phong", "n": 20, "pump": "controlled",
+                                  "times": 1, "id": "x", "wavelengths": "450, 550"})
+    old, _ = _model_from_props({"model": "modified-phong", "n": 20, "pump": 1,
+                                "pump_g": "controlled"})
+    assert new.stages == old.stages == ["controlled"]
+    np.testing.assert_array_equal(new.eval(wi, wo), old.eval(wi, wo))
+    np.testing.assert_array_equal(lam, [450.0, 550.0])
+    plain, _ = _model_from_props({"model": "lambert", "pump": 0})
+    assert plain.name == "lambert"
+    with pytest.raises(ParameterError, match='give "pump": "max"|"controlled" with "times"'):
+        _model_from_props({"model": "lambert", "pump": 2, "times": 2})
+    with pytest.raises(ParameterError, match="not both"):
+        _model_from_props({"model": "lambert", "pump": "max", "pump_g": "max"})

@@ -15,32 +15,18 @@ through it, so a model is described one way everywhere:
   "pump": {"g": G, "times": K}}`` (a list of such for stages with different g);
 - :meth:`ModelSpec.from_properties` — a flat property list (the Mitsuba plugin:
   ``{"model": NAME, "pump": G, "times": K, PARAM: VALUE, …}``);
-- :meth:`ModelSpec.of` — the spec of a built model (``of(m).build()`` has
-  ``m``'s values);
+- :meth:`ModelSpec.of` — the spec of a built model (``of(m).build()`` has its values);
 - :meth:`ModelSpec.build` — the model.
 
-What to build (:data:`KINDS`, the first kind that claims the name builds it)
---------------------------------------------------------------------------
-======================================  =================================================
-written as                              built
-======================================  =================================================
-``merl:NAME[@nbrdf|npf|abc|sgd]``,      a built-in measured material
-``rgl:NAME``, ``nielsen:NAME``          (:func:`brdfkit.data.material`); no parameters
-``PATH.binary`` or an ``os.PathLike``   a MERL file as a :class:`~brdfkit.data.MeasuredBRDF`
-                                        (parameter ``lookup``)
-``modified-phong`` (a registered name   the analytic model (:data:`brdfkit.MODELS`)
-or alias; anything else)
-======================================  =================================================
+What to build (:data:`KINDS`, the first kind that claims the name builds it): a
+built-in measured material ``merl:NAME[@nbrdf|npf|abc|sgd]``, ``rgl:NAME``,
+``nielsen:NAME`` (:func:`brdfkit.data.material`; no parameters); a MERL file
+``PATH.binary`` (:class:`~brdfkit.data.MeasuredBRDF`, parameter ``lookup``); else a
+registered model name or alias (:data:`brdfkit.MODELS`).
 
-Operators (:data:`OPERATORS`, applied in the order given)
----------------------------------------------------------
-========  ===========================  ==============================================
-key       arguments                    operator
-========  ===========================  ==============================================
-``pump``  ``g`` (``max``,              :func:`brdfkit.pumping.pump` (Neumann et al.
-          ``controlled``), ``times``   1999, eqs. 16–21)
-          (1 … :data:`MAX_TIMES`)
-========  ===========================  ==============================================
+Operators (:data:`OPERATORS`, applied in the order given): ``pump`` with ``g``
+(``max``, ``controlled``) and ``times`` (1 … :data:`MAX_TIMES`), that is
+:func:`brdfkit.pumping.pump` (Neumann et al. 1999, eqs. 16–21).
 
 A half-angle ``beta`` among the parameters (degrees on the command line,
 radians in a dict) is resolved once, when the spec is made, into the model's
@@ -174,15 +160,9 @@ def _kind(name) -> SpecKind:
 def model(name, /, **params) -> BRDF:
     """Build the model or material called *name* (module docstring) with *params*.
 
-    Parameters
-    ----------
-    name : str or os.PathLike
-        A registered model name or alias, a built-in material spec, or a path
-        to a MERL ``.binary`` file.
-    **params
-        Parameter values (API units: ``beta`` in radians); omitted ones take
-        their defaults. Built-in materials have none; a ``.binary`` material
-        has ``lookup``.
+    *name*: a registered model name or alias, a built-in material spec, or a path to
+    a MERL ``.binary`` file; *params* in API units (``beta`` in radians), omitted ones
+    at their defaults (built-in materials have none; a ``.binary`` file has ``lookup``).
 
     Raises
     ------
@@ -196,8 +176,7 @@ def model(name, /, **params) -> BRDF:
     Examples
     --------
     >>> import brdfkit
-    >>> m = brdfkit.model("modified-phong", rho_s=0.5, n=50)
-    >>> nickel = brdfkit.model("merl:nickel")
+    >>> m, nickel = brdfkit.model("modified-phong", rho_s=0.5, n=50), brdfkit.model("merl:nickel")
     """
     kind = _kind(name)
     return kind.build(kind.resolve(name), params)
@@ -291,15 +270,10 @@ def times_problem(times) -> str | None:
 # --------------------------------------------------------------------------- operators
 @dataclass(frozen=True)
 class OperatorKind:
-    """One operator a spec can apply.
-
-    ``key`` is its name and its key in the dict form; ``stages(value, d)`` reads
-    the dict form's value (*d* is the whole dict, for flat siblings such as
-    ``times``) into argument mappings, one per operator; ``check(args)``
-    validates one and returns it in canonical form; ``apply(model, args)``
-    applies it; ``value(stages)`` writes the dict form's value; ``flat`` names
-    the sibling keys of the flat form.
-    """
+    """One operator a spec can apply: ``key``, its name and dict key; ``stages(value, d)``,
+    the dict form's value (*d*: the whole dict, for flat siblings) → one argument mapping
+    per operator; ``check(args)``, validated and canonical; ``apply(model, args)``;
+    ``value(stages)``, the dict form's value; ``flat``, the flat form's sibling keys."""
 
     key: str
     stages: Callable[[object, Mapping], list]
@@ -349,6 +323,8 @@ OPERATORS: dict[str, OperatorKind] = {
                          lambda m, a: pump(m, a["g"], times=a["times"]), _pump_value,
                          flat=("times",)),
 }
+#: The dict form's keys: the target, its parameters, each operator and its flat siblings.
+_DICT_KEYS = ("model", "params", *OPERATORS, *(s for o in OPERATORS.values() for s in o.flat))
 
 
 @dataclass(frozen=True)
@@ -465,14 +441,14 @@ class ModelSpec:
         """The target's canonical name (:func:`canonical_name`)."""
         return canonical_name(self._target)
 
+    def _key(self) -> tuple:
+        return (self._target, self._params, self._operators)
+
     def __eq__(self, other):
-        if not isinstance(other, ModelSpec):
-            return NotImplemented
-        return (self._target, self._params, self._operators) == (
-            other._target, other._params, other._operators)
+        return self._key() == other._key() if isinstance(other, ModelSpec) else NotImplemented
 
     def __hash__(self):
-        return hash((self._target, self._params, self._operators))
+        return hash(self._key())
 
     def __repr__(self):
         ops = "".join(f", {o.kind}({', '.join(f'{k}={v!r}' for k, v in o.args)})"
@@ -481,19 +457,16 @@ class ModelSpec:
 
     # --------------------------------------------------------------- variants
     def with_params(self, **changes) -> ModelSpec:
-        """The same spec with some parameters changed (``beta`` resolved as usual)."""
+        """The same spec with some parameters changed (``beta`` replaces the width)."""
         params = self.params
         if "beta" in changes:
-            params.pop(self._width_name(params), None)
+            kind = _kind(self._target)
+            params.pop(kind.build(kind.resolve(self._target), params).width_param, None)
         return ModelSpec(self._target, {**params, **changes}, self._operators)
 
     def without_operators(self) -> ModelSpec:
         """The spec of the model the operators apply to."""
         return ModelSpec(self._target, self.params)
-
-    def _width_name(self, params: dict) -> str | None:
-        kind = _kind(self._target)
-        return kind.build(kind.resolve(self._target), params).width_param
 
     # --------------------------------------------------------------- build
     def build(self) -> BRDF:
@@ -512,8 +485,7 @@ class ModelSpec:
         Parameters
         ----------
         target : str
-            Registered name or alias, or a material spec (``merl:nickel``,
-            ``rgl:NAME``, ``nielsen:NAME``, a ``.binary`` path).
+            Registered name or alias, or a material spec (:data:`KINDS`).
         params : iterable of ``NAME=VALUE`` str, or mapping
             See :func:`parse_items` (``beta`` in degrees there).
         pump : {None, "max", "controlled"}
@@ -557,9 +529,8 @@ class ModelSpec:
                 f'{where}: property "model" is required (a model name such as '
                 '"modified-phong" or a material spec such as "merl:nickel")')
         spec = {"model": str(props["model"]), "params": {}}
-        flat = {"model", *OPERATORS, *(s for o in OPERATORS.values() for s in o.flat)}
         for key, value in props.items():
-            if key in flat:
+            if key in _DICT_KEYS:
                 spec.setdefault(key, value)
                 continue
             if isinstance(value, str) and "," in value:
@@ -590,11 +561,10 @@ class ModelSpec:
         """
         if not isinstance(d, Mapping) or "model" not in d:
             raise ParameterError(f"from_dict: expected a dict with a 'model' key; got {d!r}")
-        valid = ("model", "params", *OPERATORS, *(s for o in OPERATORS.values() for s in o.flat))
-        unknown = [k for k in d if k not in valid]
+        unknown = [k for k in d if k not in _DICT_KEYS]
         if unknown:
             raise ParameterError(f"from_dict: unknown key {unknown[0]!r}; valid keys: "
-                                 + ", ".join(valid))
+                                 + ", ".join(_DICT_KEYS))
         ops = [Operator(key, tuple(dict(stage).items()))
                for key in d if key in OPERATORS
                for stage in OPERATORS[key].stages(d[key], d)]

@@ -27,10 +27,10 @@ References
 
 from brdfkit.analysis.albedo_engine import AlbedoResult, albedo
 from brdfkit.analysis.hemispherical import HemisphericalAlbedo, hemispherical_albedo
-from brdfkit.analysis.monte_carlo import albedo_mc
-from brdfkit.analysis.specular_integral import H_s
 from brdfkit.analysis.lewis_table2 import table2
+from brdfkit.analysis.monte_carlo import albedo_mc
 from brdfkit.analysis.plausibility import Verdict, check
+from brdfkit.analysis.specular_integral import H_s
 
 __all__ = ["AlbedoResult", "H_s", "HemisphericalAlbedo", "Verdict", "albedo", "albedo_mc",
            "check", "hemispherical_albedo", "table2"]

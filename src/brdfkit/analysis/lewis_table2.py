@@ -165,8 +165,9 @@ def table2(*, models=None,
     Returns
     -------
     list of dict
-        Each row is :meth:`Verdict.to_dict` plus ``row`` (label), ``paper``
-        (the claims checked) and ``agrees_with_paper``.
+        Each row is :meth:`Verdict.to_dict` (with the verdict's ``status``,
+        ``success`` and ``message``) plus ``row`` (label), ``paper`` (the claims
+        checked) and ``agrees_with_paper``.
     """
     objects = [] if models is None else [m for m in models if isinstance(m, BRDF)]
     names = list(MODELS) if models is None else [resolve(n).name

@@ -32,7 +32,14 @@ import numpy as np
 from brdfkit._io import to_jsonable
 from brdfkit.cli._group import EXIT_USAGE
 from brdfkit.errors import BrdfkitError
-from brdfkit.spec import MAX_TIMES, TIMES_REASON, ModelSpec, parse_items, times_problem
+from brdfkit.spec import (
+    MAX_TIMES,
+    PUMP_CHOICES,
+    TIMES_REASON,
+    ModelSpec,
+    parse_items,
+    times_problem,
+)
 
 __all__ = [
     "EXIT_USAGE",
@@ -107,7 +114,7 @@ def model_options(func: Callable) -> Callable:
                         metavar="K",
                         help=f"Apply the pumping K times (needs --pump; 1 to {PUMP_MAX_TIMES}, "
                              f"default 1; {_TIMES_REASON}).")(func)
-    func = click.option("--pump", type=click.Choice(["max", "controlled"]), default=None,
+    func = click.option("--pump", type=click.Choice(list(PUMP_CHOICES)), default=None,
                         help="Pump up the albedo (Neumann et al. 1999, eqs. 16-21) with "
                              "g1 ('max') or g2 ('controlled').")(func)
     func = click.option("-p", "--param", "param", multiple=True, metavar="NAME=VALUE",

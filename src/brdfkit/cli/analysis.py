@@ -19,9 +19,9 @@ import click
 import numpy as np
 
 import brdfkit.cli._progress as _progress
-from brdfkit.spec import is_material_spec
 from brdfkit.cli._common import build_model, emit_json, model_options
 from brdfkit.errors import BrdfkitError
+from brdfkit.spec import PUMP_CHOICES, is_material_spec
 
 __all__ = ["MAX_ANGLES", "parse_theta", "albedo_cmd", "check_cmd", "table2_cmd", "figure_cmd"]
 
@@ -247,7 +247,7 @@ def table2_cmd(as_json, as_md, models):
                    "--times apply to it.")
 @click.option("-p", "--param", "param", multiple=True, metavar="NAME=VALUE",
               help="Parameter of --model (repeatable), as in 'brdfkit eval'.")
-@click.option("--pump", type=click.Choice(["max", "controlled"]), default=None,
+@click.option("--pump", type=click.Choice(list(PUMP_CHOICES)), default=None,
               help="Pump --model's albedo up (g1 'max' or g2 'controlled').")
 @click.option("--times", type=int, default=None, metavar="K",
               help="Apply --pump K times.")

@@ -20,8 +20,8 @@ import click
 import brdfkit.cli._progress as _progress
 from brdfkit.cli._common import PARAM_HELP, emit_json
 from brdfkit.errors import BrdfkitError
-from brdfkit.spec import ModelSpec, canonical_name, parse_items
 from brdfkit.fitting import LOSSES, PROCEDURES  # the registries' names (--loss, --procedure)
+from brdfkit.spec import PUMP_CHOICES, ModelSpec, canonical_name, parse_items
 
 __all__ = ["fit_cmd"]
 
@@ -34,7 +34,7 @@ __all__ = ["fit_cmd"]
               help="Start a parameter at VALUE and fit it (-p holds it instead); frees an "
                    "optional one that is off by default, e.g. --start eta=1.5 fits a "
                    "Fresnel index.")
-@click.option("--pump", type=click.Choice(["max", "controlled"]), default=None,
+@click.option("--pump", type=click.Choice(list(PUMP_CHOICES)), default=None,
               help="Fit the pumped model (its base parameters are fitted).")
 @click.option("--times", type=int, default=None, metavar="K", help="Pump K times (with --pump).")
 @click.option("--to", "to", required=True, multiple=True, metavar="SPEC",

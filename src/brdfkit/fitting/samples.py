@@ -251,15 +251,24 @@ def albedo_with_error(f, w, n_theta: int, n_u: int, n_phi: int):
     if n_u % k or n_phi % k:
         raise ParameterError(f"albedo_with_error: n_u and n_phi must be multiples of {k}; "
                              f"got {n_u}, {n_phi}")
-    a = albedo_from_values(f, w, n_theta)
-    f = np.where(w[:, None] > 0.0, f, 0.0)
-    terms = (f * w[:, None]).reshape(n_theta, n_u, n_phi, f.shape[1])
+    # the terms once; a as albedo_from_values computes it (the same operations, so the
+    # same values)
+    terms = np.where(w[:, None] > 0.0, f, 0.0) * w[:, None]
+    C = terms.shape[1]
+    a = terms.reshape(n_theta, -1, C).sum(axis=1)
+    t = terms.reshape(n_theta, n_u, n_phi, C)
     # the coarse cells' midpoints are fine nodes k·j + (k − 1)/2, their weights k (one
     # axis) or k² (both) times the fine ones' (du, dφ k times wider; the rest is evaluated
     # at the same node)
     mid = (k - 1) // 2
-    coarse_u = k * terms[:, mid::k, :, :].sum(axis=(1, 2))
-    coarse_phi = k * terms[:, :, mid::k, :].sum(axis=(1, 2))
-    coarse_both = (k * k) * terms[:, mid::k, mid::k, :].sum(axis=(1, 2))
+    # sums over φ (T, n_u, C), of every node and of every k-th, as matrix products (5×
+    # faster than sums over a middle axis; the estimate does not need their rounding)
+    every, kth = np.ones(n_phi), np.zeros(n_phi)
+    kth[mid::k] = 1.0
+    tp = t.transpose(0, 1, 3, 2)
+    by_u, by_u_coarse_phi = tp @ every, tp @ kth
+    coarse_u = k * by_u[:, mid::k].sum(axis=1)
+    coarse_phi = k * by_u_coarse_phi.sum(axis=1)
+    coarse_both = (k * k) * by_u_coarse_phi[:, mid::k].sum(axis=1)
     spread = np.abs(a - coarse_u) + np.abs(a - coarse_phi) + np.abs(a - coarse_both)
     return a, np.broadcast_to(spread.max(axis=0), a.shape).copy()

