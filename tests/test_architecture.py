@@ -19,7 +19,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "brdfkit"
 #: docs/architecture.md, "Layers"
 LAYER = {
     "errors": 0, "_array": 0, "_kern": 0, "geometry": 0, "fresnel": 0, "halfangle": 0,
-    "tables": 0, "_io": 0, "_dual": 0, "status": 0,
+    "tables": 0, "_io": 0, "_dual": 0, "status": 0, "colour": 0,
     # the package root is the public facade (brdfkit.model resolves model names and
     # material specs): layer 2, so the data layer is below it and cli/figures above
     "": 2, "_specs": 2, "models": 1,

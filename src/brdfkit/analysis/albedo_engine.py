@@ -76,6 +76,7 @@ from brdfkit.analysis.quadrature import (  # the compiled core
 )
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models._base import BRDF
+from brdfkit.models._drivers import generic_loop
 
 __all__ = ["AlbedoResult", "albedo", "albedo_mc", "hemispherical_albedo", "H_s", "lobe_frame",
            "STATUS_MESSAGES", "CONVERGED", "MAX_LEVEL_REACHED", "NODE_CAP", "NONFINITE"]
@@ -106,14 +107,10 @@ def _eval_kernel(kernel, P, thetas, offsets, wo, vals, bad):  # pragma: no cover
                     bad[i] += 1
 
 
-@numba.njit
-def _eval_pairs_serial(kernel, wi, wo, P, out):  # pragma: no cover - compiled
-    """:func:`brdfkit.models.eval_pairs` for the analyses: serial (cheaper to compile, see
-    :func:`_eval_kernel`), no direction checks (the analyses build unit directions)."""
-    for j in range(wi.shape[0]):
-        for ch in range(P.shape[0]):
-            out[j, ch] = kernel(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2],
-                                P[ch])
+#: :func:`brdfkit.models.eval_pairs` for the analyses: serial (cheaper to compile, see
+#: :func:`_eval_kernel`), no direction checks (the analyses build unit directions); the
+#: plain loop of models/_drivers with the kernel an argument.
+_eval_pairs_serial = generic_loop("plain", parallel=False)
 
 
 def evaluate_pairs(model, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:

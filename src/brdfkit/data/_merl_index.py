@@ -39,6 +39,8 @@ import math
 import numba
 import numpy as np
 
+from brdfkit.models._drivers import loop_driver
+
 
 @numba.njit(cache=True, inline="always")
 def _half_diff_vec(ix, iy, iz, ox, oy, oz):
@@ -281,20 +283,33 @@ def _index_tables() -> np.ndarray:
     return Q
 
 
-@numba.njit(cache=True, parallel=True)
-def _indices(wi, wo, Q, out):  # pragma: no cover - compiled
-    for j in numba.prange(wi.shape[0]):
-        hz, dx, dy, dz = _half_diff_vec(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1],
-                                        wo[j, 2])
-        out[j] = _fast_index(hz, dx, dy, dz, Q)
+@numba.njit(cache=True)
+def _index_kernel(ix, iy, iz, ox, oy, oz, Q):
+    """The fast nearest index of one pair (exact as a float64: < 2^53), a kernel of the
+    plain loop (models/_drivers) over packed row Q (:func:`_index_tables`)."""
+    hz, dx, dy, dz = _half_diff_vec(ix, iy, iz, ox, oy, oz)
+    return float(_fast_index(hz, dx, dy, dz, Q))
 
 
-@numba.njit(cache=True, parallel=True)
-def _indices_formula(wi, wo, out):  # pragma: no cover - compiled
+@numba.njit(cache=True)
+def _index_formula_kernel(ix, iy, iz, ox, oy, oz, q):
     """The index from the angles (acos, atan2), as the reference: the fast path's check."""
-    for j in numba.prange(wi.shape[0]):
-        th, td, pd = _half_diff(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2])
-        out[j] = _nearest_index(th, td, pd)
+    th, td, pd = _half_diff(ix, iy, iz, ox, oy, oz)
+    return float(_nearest_index(th, td, pd))
+
+
+def _indices(wi, wo, Q, out) -> None:
+    """out[j] = the fast nearest index of pair j (int64), through the generated plain loop."""
+    col = np.empty((wi.shape[0], 1))
+    loop_driver(_index_kernel, loop="plain")(wi, wo, Q.reshape(1, -1), col)
+    out[:] = col[:, 0]
+
+
+def _indices_formula(wi, wo, out) -> None:
+    """out[j] = the index from the angles (:func:`_nearest_index`), the plain loop."""
+    col = np.empty((wi.shape[0], 1))
+    loop_driver(_index_formula_kernel, loop="plain")(wi, wo, np.empty((1, 0)), col)
+    out[:] = col[:, 0]
 
 
 @numba.njit(cache=True, inline="always")

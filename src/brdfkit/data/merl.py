@@ -81,7 +81,9 @@ from brdfkit.data._merl_index import (
 )
 from brdfkit.data.sampler import TabulatedSampler
 from brdfkit.errors import DataFileError, ParameterError
+from brdfkit.geometry import merl_theta_h
 from brdfkit.models._base import DerivedBRDF, Lobe, Param, _unit_pair
+from brdfkit.models._drivers import blocked_driver
 
 __all__ = ["MerlTable", "read_binary", "write_binary", "merl_indices", "table_from_function",
            "MeasuredBRDF", "SCALES", "SHAPE", "N_BINS"]
@@ -272,79 +274,82 @@ def _fill(out, j, n_channels, status):
         out[j, c] = v
 
 
-@numba.njit(cache=True, parallel=True)
-def _nearest_driver(wi, wo, data, out):  # pragma: no cover - compiled
-    """:meth:`BRDF.eval`'s checked pass for the ``nearest`` lookup. ``data`` (flat): the
-    index tables (:func:`_index_tables`, _NQ numbers), then the channel-interleaved table
-    (bin i, channel c at ``_NQ + C·i + c``): the bin is found once per pair for all
-    channels, whose values share a cache line (the generic loop around
-    :func:`_measured_kernel` finds it per channel and reads three planar rows: ~3 cache
-    and TLB misses per random pair). Blocks of _BLOCK pairs. Returns the number of pairs
-    that are not finite unit vectors (their rows NaN), as the generic driver does."""
-    n = wi.shape[0]
-    n_channels = out.shape[1]
-    Q = data[:_NQ]
-    n_bad = 0
-    for q in numba.prange((n + _BLOCK - 1) // _BLOCK):
-        lo = q * _BLOCK
-        hi = min(n, lo + _BLOCK)
-        k = np.empty(_BLOCK, dtype=np.int64)  # the bin's offset in data, or a marker
-        for j in range(lo, hi):
-            ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
-            ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-            s = _status(ix, iy, iz, ox, oy, oz)
-            if s == 0:
-                hz, dx, dy, dz = _half_diff_vec(ix, iy, iz, ox, oy, oz)
-                k[j - lo] = _NQ + n_channels * _fast_index(hz, dx, dy, dz, Q)
-            else:
-                k[j - lo] = s
-        for j in range(lo, hi):
-            kj = k[j - lo]
-            if kj >= 0:
-                for c in range(n_channels):
-                    out[j, c] = data[kj + c]
-            else:
-                _fill(out, j, n_channels, kj)
-                if kj == _BAD:
-                    n_bad += 1
-    return n_bad
+# The table loops of MeasuredBRDF.eval: the blocked loop of models/_drivers (locate a block
+# of pairs, then read it), generated with these hooks and cached on disk. ``data`` (flat):
+# the index tables (:func:`_index_tables`, _NQ numbers; _fast_index reads them by absolute
+# index, so the whole array is passed), then the channel-interleaved table (bin i, channel c
+# at ``_NQ + C·i + c``): the bin is found once per pair for all channels, whose values share
+# a cache line (the checked loop around :func:`_measured_kernel` finds it per channel and
+# reads three planar rows: ~3 cache and TLB misses per random pair). Both return the number
+# of pairs that are not finite unit vectors (their rows NaN), as the checked loop does.
+@numba.njit(cache=True, inline="always")
+def _nearest_state():
+    return np.empty(_BLOCK, dtype=np.int64)  # the pair's bin, or a marker
 
 
-@numba.njit(cache=True, parallel=True)
-def _linear_driver(wi, wo, data, out):  # pragma: no cover - compiled
-    """:func:`_nearest_driver` for the ``linear`` lookup (the same ``data``): the cell and
-    weights are computed once per pair for all channels."""
-    n = wi.shape[0]
+@numba.njit(cache=True, inline="always")
+def _nearest_pair(k, t, ix, iy, iz, ox, oy, oz, data):
+    s = _status(ix, iy, iz, ox, oy, oz)
+    if s == 0:
+        hz, dx, dy, dz = _half_diff_vec(ix, iy, iz, ox, oy, oz)
+        k[t] = _fast_index(hz, dx, dy, dz, data)
+    else:
+        k[t] = s
+
+
+@numba.njit(cache=True, inline="always")
+def _nearest_emit(k, t, data, out, j):
     n_channels = out.shape[1]
-    n_bad = 0
-    for q in numba.prange((n + _BLOCK - 1) // _BLOCK):
-        lo = q * _BLOCK
-        hi = min(n, lo + _BLOCK)
-        k = np.empty(_BLOCK, dtype=np.int64)  # the cell's first corner, or a marker
-        step = np.empty(_BLOCK, dtype=np.int64)
-        frac = np.empty((_BLOCK, 3))
-        for j in range(lo, hi):
-            ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
-            ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-            s = _status(ix, iy, iz, ox, oy, oz)
-            if s == 0:
-                theta_h, theta_d, phi_d = _half_diff(ix, iy, iz, ox, oy, oz)
-                i = j - lo
-                k[i], step[i], frac[i, 0], frac[i, 1], frac[i, 2] = _linear_coords(
-                    theta_h, theta_d, phi_d)
-            else:
-                k[j - lo] = s
-        for j in range(lo, hi):
-            i = j - lo
-            if k[i] >= 0:
-                for c in range(n_channels):
-                    out[j, c] = _linear_sum(data, n_channels, _NQ + c, k[i], step[i],
-                                            frac[i, 0], frac[i, 1], frac[i, 2])
-            else:
-                _fill(out, j, n_channels, k[i])
-                if k[i] == _BAD:
-                    n_bad += 1
-    return n_bad
+    kj = k[t]
+    if kj >= 0:
+        base = _NQ + n_channels * kj
+        for c in range(n_channels):
+            out[j, c] = data[base + c]
+        return 0
+    _fill(out, j, n_channels, kj)
+    return 1 if kj == _BAD else 0
+
+
+@numba.njit(cache=True, inline="always")
+def _linear_state():
+    # the cell's first corner (or a marker), the φ_d step, the fractions (t_h, t_d, t_p)
+    return (np.empty(_BLOCK, dtype=np.int64), np.empty(_BLOCK, dtype=np.int64),
+            np.empty((_BLOCK, 3)))
+
+
+@numba.njit(cache=True, inline="always")
+def _linear_pair(state, t, ix, iy, iz, ox, oy, oz, data):
+    k, step, frac = state
+    s = _status(ix, iy, iz, ox, oy, oz)
+    if s == 0:
+        theta_h, theta_d, phi_d = _half_diff(ix, iy, iz, ox, oy, oz)
+        k[t], step[t], frac[t, 0], frac[t, 1], frac[t, 2] = _linear_coords(
+            theta_h, theta_d, phi_d)
+    else:
+        k[t] = s
+
+
+@numba.njit(cache=True, inline="always")
+def _linear_emit(state, t, data, out, j):
+    k, step, frac = state
+    n_channels = out.shape[1]
+    if k[t] >= 0:
+        for c in range(n_channels):
+            out[j, c] = _linear_sum(data, n_channels, _NQ + c, k[t], step[t],
+                                    frac[t, 0], frac[t, 1], frac[t, 2])
+        return 0
+    _fill(out, j, n_channels, k[t])
+    return 1 if k[t] == _BAD else 0
+
+
+_TABLE_HOOKS = {"nearest": (_nearest_state, _nearest_pair, _nearest_emit),
+                "linear": (_linear_state, _linear_pair, _linear_emit)}
+
+
+def _table_driver(lookup: str):
+    """The blocked loop of lookup *lookup* (``"nearest"`` or ``"linear"``), generated once."""
+    state, pair, emit = _TABLE_HOOKS[lookup]
+    return blocked_driver(state=state, pair=pair, emit=emit, block=_BLOCK)
 
 
 # --------------------------------------------------------------------------- tabulation
@@ -352,7 +357,7 @@ def bin_centres() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """θ_h, θ_d, φ_d at the bin centres (radians): the index coordinates i + ½ mapped back
     (θ_h = (u/90)²·π/2 — MERL's quadratic spacing), shapes (90,), (90,), (180,)."""
     u = np.arange(90) + 0.5
-    theta_h = (u / 90.0) ** 2 * (0.5 * np.pi)
+    theta_h = merl_theta_h(u / 90.0)
     theta_d = u / 90.0 * (0.5 * np.pi)
     phi_d = (np.arange(180) + 0.5) / 180.0 * np.pi
     return theta_h, theta_d, phi_d
@@ -574,8 +579,7 @@ class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
             isotropic=_mirror_symmetric(values))
         self.n_channels = 3
         # one bin computation per pair for all channels
-        self._driver = (_linear_driver if self._values["lookup"] == "linear"
-                        else _nearest_driver)
+        self._driver = _table_driver(self._values["lookup"])
 
     def _pack(self) -> np.ndarray:
         mode = LINEAR if self._values["lookup"] == "linear" else NEAREST
@@ -585,7 +589,7 @@ class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
         return out
 
     def _driver_data(self) -> np.ndarray:
-        """What :func:`_nearest_driver` and :func:`_linear_driver` read (built once): the
+        """What the table loops (:func:`_table_driver`) read (built once): the
         index tables, then the channel-interleaved table."""
         if self._interleaved is None:
             t = np.empty(_NQ + 3 * N_BINS)

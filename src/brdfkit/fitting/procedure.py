@@ -100,7 +100,7 @@ reported (``at_bounds``, status AT_BOUND, named in the message) — never a
 plain "converged". Every stage record lists the coordinates at a bound after
 it.
 
-The fit evaluates on one thread (``numba.set_num_threads(1)``, restored
+The fit evaluates on one thread (``models._drivers.numba_threads(1)``, restored
 after): for ~15,000 pairs the parallel driver's thread wake-ups cost more
 than the work on a shared 2-core machine (measured: 16 ms vs 0.3 ms).
 """
@@ -111,7 +111,6 @@ import math
 import time
 from dataclasses import dataclass, field
 
-import numba
 import numpy as np
 
 from brdfkit.errors import BrdfkitError, ParameterError
@@ -129,6 +128,7 @@ from brdfkit.fitting.samples import (
     merl_samples,
 )
 from brdfkit.models import BRDF
+from brdfkit.models._drivers import numba_threads
 from brdfkit.pumping import PumpedBRDF
 from brdfkit.pumping.surrogate import surrogate
 
@@ -314,13 +314,9 @@ def fit(model: BRDF, target: BRDF, *, loss: str = "l1", procedure: str = "auto",
     if fixed:
         model = model.with_params(**fixed)  # validates names and values
         fixed = {k: model.values[k] for k in fixed}
-    threads = numba.get_num_threads()
-    numba.set_num_threads(1)  # see the module docstring
-    try:
+    with numba_threads(1):  # see the module docstring
         return _fit(model, target, loss, "staged" if procedure == "auto" else procedure,
                     fixed, theta_max, seed, n_starts, strides, max_evals, progress)
-    finally:
-        numba.set_num_threads(threads)
 
 
 def _fit(model, target, loss, procedure, fixed, theta_max, seed, n_starts, strides,

@@ -29,7 +29,7 @@ Public objects
 - :class:`DerivedBRDF` — the one constructor path for models built from others.
 - :func:`eval_pairs`, :func:`eval_pairs_checked`, :func:`checked_driver` — the
   compiled loops over all pairs, defined in :mod:`brdfkit.models._drivers` and
-  imported here (the loop :meth:`BRDF.eval` runs: :func:`~brdfkit.models._drivers.cached_driver`).
+  imported here (the loop :meth:`BRDF.eval` runs: :func:`~brdfkit.models._drivers.loop_driver`).
 """
 
 from __future__ import annotations
@@ -39,7 +39,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import ClassVar
 
-import numba
 import numpy as np
 
 from brdfkit._array import as_directions, as_uniform
@@ -54,6 +53,8 @@ from brdfkit.models._drivers import (  # noqa: F401  (re-exported: models import
     checked_driver,
     eval_pairs,
     eval_pairs_checked,
+    loop_driver,
+    numba_threads,
 )
 from brdfkit.models.sampling import COSINE
 
@@ -285,7 +286,8 @@ class BRDF:
     #: settle in one end's basin when the other end fits better.
     fit_bound_starts: ClassVar[tuple[str, ...]] = ()
     #: Compiled loop specialised to ``kernel`` (:func:`checked_driver`), or None for the
-    #: generic :func:`eval_pairs_checked` (a composite kernel, e.g. pumped, sets one).
+    #: checked loop generated for ``kernel`` (:func:`loop_driver`; a composite or table
+    #: kernel, e.g. pumped or measured, sets one).
     _driver: Callable | None = None
 
     # ------------------------------------------------------------------ set-up
@@ -511,21 +513,14 @@ class BRDF:
         wi2 = np.ascontiguousarray(wi).reshape(-1, 3)
         wo2 = np.ascontiguousarray(wo).reshape(-1, 3)
         out = np.empty((wi2.shape[0], self._packed.shape[0]))
-        driver = self._driver
-        threads = numba.get_num_threads()
-        if wi2.shape[0] < SERIAL_BELOW:
-            numba.set_num_threads(1)  # thread-local: only this call's parallel regions
-        try:
-            if driver is not None:
-                n_bad = driver(wi2, wo2, self._driver_data(), out)
-            else:
-                # the generic loop, compiled once per kernel and kept on disk when the
-                # kernel has an importable name (models/_drivers.py)
-                cached = cached_driver(self.kernel)
-                n_bad = (cached(wi2, wo2, self._packed, out) if cached is not None
-                         else eval_pairs_checked(self.kernel, wi2, wo2, self._packed, out))
-        finally:
-            numba.set_num_threads(threads)
+        # the model's own loop, else the checked loop generated for its kernel (cached on
+        # disk: models/_drivers.py); small calls on this thread alone (SERIAL_BELOW)
+        if self._driver is not None:
+            driver, data = self._driver, self._driver_data()
+        else:
+            driver, data = loop_driver(self.kernel), self._packed
+        with numba_threads(1 if wi2.shape[0] < SERIAL_BELOW else None):
+            n_bad = driver(wi2, wo2, data, out)
         if n_bad:
             as_directions(wi_in, "wi")  # raises the usual BrdfkitError for NaN/inf
             as_directions(wo_in, "wo")

@@ -27,6 +27,7 @@ References
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numba
 import numpy as np
@@ -50,6 +51,7 @@ from brdfkit.models._lobes import (
     lobe_hint,
     lobe_pow,
 )
+from brdfkit.models._params import ETA
 from brdfkit.models._registry import register
 from brdfkit.models.sampling import COSINE, Mixture, blinn_lobe, normalised_weights, phong_lobe
 from brdfkit.models.specular import blinn_normal_albedo
@@ -206,8 +208,7 @@ class Nielsen(CosineLobeBRDF):
               kind="colour"),
         Param("s", 20.0, 0.0, 1e6, "", "shininess exponent"),
         Param("alpha", 0.5, 0.0, 1.0, "", "mix: 0 Phong (R.V), 1 Blinn-Phong (N.H)^4"),
-        Param("eta", None, 0.0, 100.0, "", "refractive index; none: F = 1", kind="colour",
-              lower_open=True, optional=True),
+        replace(ETA, doc="refractive index; none: F = 1"),
     )
     citation = "Nielsen et al. eq. (3), Fresnel factor as in the text"
     fit_bound_starts = ("alpha",)  # α = 0: the Phong-like lobe, α = 1: the Blinn-like one

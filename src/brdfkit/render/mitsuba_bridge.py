@@ -134,6 +134,7 @@ from collections.abc import Callable
 import numpy as np
 
 from brdfkit._specs import model as build_model
+from brdfkit.colour import MITSUBA_LUMINANCE
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models import BRDF
 from brdfkit.pumping import pump
@@ -149,7 +150,7 @@ FALLBACK = {"llvm_ad_rgb": "scalar_rgb", "llvm_ad_mono": "scalar_rgb",
 VARIANTS = tuple(FALLBACK)
 
 #: Rec. 709 luminance weights of linear sRGB (Mitsuba's ``luminance``; ITU-R BT.709).
-LUMINANCE = np.array([0.212671, 0.715160, 0.072169])
+LUMINANCE = MITSUBA_LUMINANCE  # brdfkit.colour: as Mitsuba's own conversion (traced route)
 
 _FLAGS = ("SymbolicLoops", "SymbolicCalls", "SymbolicConditionals")
 _REGISTERED: set[str] = set()
