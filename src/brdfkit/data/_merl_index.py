@@ -283,7 +283,9 @@ def _index_tables() -> np.ndarray:
     return Q
 
 
-@numba.njit(cache=True)
+# inline="always": inlined into the loop's prange body, which Numba compiles with the NumPy
+# error model (a division by 0 gives inf, no exception), as the former hand-written loops
+@numba.njit(cache=True, inline="always")
 def _index_kernel(ix, iy, iz, ox, oy, oz, Q):
     """The fast nearest index of one pair (exact as a float64: < 2^53), a kernel of the
     plain loop (models/_drivers) over packed row Q (:func:`_index_tables`)."""
@@ -291,7 +293,7 @@ def _index_kernel(ix, iy, iz, ox, oy, oz, Q):
     return float(_fast_index(hz, dx, dy, dz, Q))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _index_formula_kernel(ix, iy, iz, ox, oy, oz, q):
     """The index from the angles (acos, atan2), as the reference: the fast path's check."""
     th, td, pd = _half_diff(ix, iy, iz, ox, oy, oz)

@@ -312,34 +312,39 @@ def _nearest_emit(k, t, data, out, j):
 
 @numba.njit(cache=True, inline="always")
 def _linear_state():
-    # the cell's first corner (or a marker), the φ_d step, the fractions (t_h, t_d, t_p)
-    return (np.empty(_BLOCK, dtype=np.int64), np.empty(_BLOCK, dtype=np.int64),
-            np.empty((_BLOCK, 3)))
+    # per pair: the cell's first corner (or a marker), the φ_d step, the fractions (t_h,
+    # t_d, t_p); one array (a tuple of arrays built in an inlined hook crashed Numba's
+    # parallel lowering), the two integers held exactly as floats (< 2^53)
+    return np.empty((_BLOCK, 5))
 
 
 @numba.njit(cache=True, inline="always")
 def _linear_pair(state, t, ix, iy, iz, ox, oy, oz, data):
-    k, step, frac = state
     s = _status(ix, iy, iz, ox, oy, oz)
     if s == 0:
         theta_h, theta_d, phi_d = _half_diff(ix, iy, iz, ox, oy, oz)
-        k[t], step[t], frac[t, 0], frac[t, 1], frac[t, 2] = _linear_coords(
-            theta_h, theta_d, phi_d)
+        k, step, th, td, tp = _linear_coords(theta_h, theta_d, phi_d)
+        state[t, 0] = k
+        state[t, 1] = step
+        state[t, 2] = th
+        state[t, 3] = td
+        state[t, 4] = tp
     else:
-        k[t] = s
+        state[t, 0] = s
 
 
 @numba.njit(cache=True, inline="always")
 def _linear_emit(state, t, data, out, j):
-    k, step, frac = state
     n_channels = out.shape[1]
-    if k[t] >= 0:
+    k = int(state[t, 0])
+    if k >= 0:
+        step = int(state[t, 1])
         for c in range(n_channels):
-            out[j, c] = _linear_sum(data, n_channels, _NQ + c, k[t], step[t],
-                                    frac[t, 0], frac[t, 1], frac[t, 2])
+            out[j, c] = _linear_sum(data, n_channels, _NQ + c, k, step,
+                                    state[t, 2], state[t, 3], state[t, 4])
         return 0
-    _fill(out, j, n_channels, k[t])
-    return 1 if k[t] == _BAD else 0
+    _fill(out, j, n_channels, k)
+    return 1 if k == _BAD else 0
 
 
 _TABLE_HOOKS = {"nearest": (_nearest_state, _nearest_pair, _nearest_emit),
