@@ -63,6 +63,7 @@ in the next process.
 from __future__ import annotations
 
 import ast
+import functools
 import hashlib
 import importlib
 import importlib.util
@@ -271,6 +272,7 @@ LOOPS = {
 }
 
 
+@functools.lru_cache(maxsize=None)  # bounded: one entry per (loop, flags), a dozen at most
 def _loop_source(loop: str, *, cache: bool, generic: bool = False,
                  parallel: bool = True) -> str:
     """The functions of loop *loop* as source, decorated (``cache=True`` when *cache*), with
