@@ -272,7 +272,7 @@ LOOPS = {
 }
 
 
-@functools.lru_cache(maxsize=None)  # bounded: one entry per (loop, flags), a dozen at most
+@functools.lru_cache(maxsize=32)  # one entry per (loop, flags): 4 loops × 8 flag sets
 def _loop_source(loop: str, *, cache: bool, generic: bool = False,
                  parallel: bool = True) -> str:
     """The functions of loop *loop* as source, decorated (``cache=True`` when *cache*), with
