@@ -46,10 +46,8 @@ Public objects
   :func:`sgd_material` — build one from its fitted numbers.
 - :data:`CITATIONS`, :data:`LICENCES` — per representation / data source.
 - Kernels: :func:`nbrdf_kernel`, :func:`npf_kernel`, :func:`abc_kernel`,
-  :func:`sgd_kernel`, each evaluated by the checked loop generated for it and
-  cached on disk (:func:`brdfkit.models._drivers.loop_driver`); NBRDF by its own
-  :func:`nbrdf_driver` (all three channels from one network evaluation, blocked
-  over pairs).
+  :func:`sgd_kernel` (each run by its generated checked loop, cached on disk);
+  :func:`nbrdf_driver` (NBRDF: all channels from one net evaluation, in blocks).
 
 References
 ----------
