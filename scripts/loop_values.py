@@ -19,13 +19,16 @@ from brdfkit.pumping import pump
 
 rng = np.random.default_rng(1)
 n = 6000
-w = rng.normal(size=(2, n, 3)); w /= np.linalg.norm(w, axis=-1, keepdims=True)
-w[0, : n // 2, 2] = np.abs(w[0, : n // 2, 2]); w[1, : n // 3, 2] = np.abs(w[1, : n // 3, 2])
+w = rng.normal(size=(2, n, 3))
+w /= np.linalg.norm(w, axis=-1, keepdims=True)
+w[0, : n // 2, 2] = np.abs(w[0, : n // 2, 2])
+w[1, : n // 3, 2] = np.abs(w[1, : n // 3, 2])
 wi, wo = np.ascontiguousarray(w[0]), np.ascontiguousarray(w[1])
 g = np.linspace(0, np.pi / 2, 30)
 t, p = np.meshgrid(g, np.linspace(0, 2 * np.pi, 12))
 d = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1).reshape(-1, 3)
-wi2 = np.repeat(d, d.shape[0], 0); wo2 = np.tile(d, (d.shape[0], 1))
+wi2 = np.repeat(d, d.shape[0], 0)
+wo2 = np.tile(d, (d.shape[0], 1))
 small = (wi[:100], wo[:100])  # serial path
 out = {}
 for name, cls in MODELS.items():
