@@ -29,14 +29,9 @@ import brdfkit
 from brdfkit.errors import ParameterError
 from brdfkit.fresnel import fresnel_conductor, fresnel_dielectric
 from brdfkit.geometry import local_to_world, spherical_to_cartesian
-from brdfkit.models.microfacet import (
-    d_beckmann,
-    d_ggx,
-    g_vgroove,
-    htsg_series,
-    htsg_shadow,
-    htsg_sigma,
-)
+from brdfkit.models.he_torrance import htsg_series, htsg_shadow, htsg_sigma
+from brdfkit.models.microfacet import d_beckmann, d_ggx
+from brdfkit.models.vgroove import g_vgroove
 
 NORMAL = np.array([0.0, 0.0, 1.0])
 LN2 = math.log(2.0)

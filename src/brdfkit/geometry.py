@@ -12,6 +12,8 @@ Public objects
 - :func:`half_vector` — normalised bisector H of two directions.
 - :func:`to_rusinkiewicz`, :func:`from_rusinkiewicz` — half/difference
   angles (θ_h, θ_d, φ_d) of Rusinkiewicz 1998, as used by MERL.
+- :func:`merl_theta_h` — MERL's quadratic θ_h grid θ_h = (π/2)u², u ∈ [0, 1]
+  (the bins, the fitting samples and edges, the explorer's θ_h axis).
 - :func:`sample_uniform_hemisphere`, :func:`pdf_uniform_hemisphere`
 - :func:`sample_cosine_hemisphere`, :func:`pdf_cosine_hemisphere`
 - :func:`frame_around` — an orthonormal frame whose third axis is a given
@@ -38,6 +40,7 @@ __all__ = [
     "half_vector",
     "to_rusinkiewicz",
     "from_rusinkiewicz",
+    "merl_theta_h",
     "sample_uniform_hemisphere",
     "pdf_uniform_hemisphere",
     "sample_cosine_hemisphere",
@@ -127,6 +130,14 @@ def from_rusinkiewicz(theta_h, phi_h, theta_d, phi_d) -> tuple[np.ndarray, np.nd
     wi = rotate_z(rotate_y(d, theta_h), phi_h)
     wo = rotate_z(rotate_y(d_mirror, theta_h), phi_h)
     return wi, wo
+
+
+def merl_theta_h(u) -> np.ndarray:
+    """θ_h = (π/2)·u² (radians) of MERL's quadratic θ_h spacing, for index coordinates
+    u ∈ [0, 1] (u = (i + ½)/90 at bin i's centre): dense near the specular peak at
+    θ_h = 0; dθ_h/du = π u. Computed as (u·u)·(π/2), the rounding every caller used."""
+    u = np.asarray(u, dtype=np.float64)
+    return u * u * (0.5 * np.pi)
 
 
 def sample_uniform_hemisphere(u) -> np.ndarray:

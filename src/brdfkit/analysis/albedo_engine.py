@@ -66,7 +66,6 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 
 from brdfkit.analysis.quadrature import (  # the compiled core
@@ -86,44 +85,21 @@ from brdfkit.analysis.quadrature import (  # the compiled core
 )
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models._base import BRDF
+from brdfkit.models._drivers import generic_loop, loop_driver
 from brdfkit.status import STATUS
 
 __all__ = ["AlbedoResult", "albedo", "evaluate_pairs", "check_theta", "lobe_frame",
            "STATUS_MESSAGES", "CONVERGED", "MAX_LEVEL_REACHED", "NODE_CAP", "NONFINITE"]
 
 
-# Not cached: a specialisation is keyed on the kernel's dispatcher, new in every
-# process, so an on-disk entry is never reused (same reason as models.eval_pairs).
-# Serial: compiles in ~0.3 s per model instead of ~1 s for a prange loop (this
-# matters for Table 2, which compiles it for every registered model).
-@numba.njit
-def _eval_kernel(kernel, P, thetas, offsets, wo, vals, bad):  # pragma: no cover - compiled
-    """vals[j, c] = kernel(ω_i(θ of j), wo[j], P[c]); bad[i] counts the non-finite values of
-    angle i (stored as 0 so that they cannot poison the sums of the other angles)."""
-    for i in range(thetas.shape[0]):
-        ix = math.sin(thetas[i])
-        iz = math.cos(thetas[i])
-        for j in range(offsets[i], offsets[i + 1]):
-            for ch in range(P.shape[0]):
-                if wo[j, 2] <= 0.0:
-                    vals[j, ch] = 0.0
-                    continue
-                v = kernel(ix, 0.0, iz, wo[j, 0], wo[j, 1], wo[j, 2], P[ch])
-                if math.isfinite(v):
-                    vals[j, ch] = v
-                else:
-                    vals[j, ch] = 0.0
-                    bad[i] += 1
 
+# The engine's loop over (θ_i, ω_o) nodes is the "albedo" loop of models/_drivers, generated
+# per kernel and cached on disk (it was compiled in every process: 0.3-2 s per model).
 
-@numba.njit
-def _eval_pairs_serial(kernel, wi, wo, P, out):  # pragma: no cover - compiled
-    """:func:`brdfkit.models.eval_pairs` for the analyses: serial (cheaper to compile, see
-    :func:`_eval_kernel`), no direction checks (the analyses build unit directions)."""
-    for j in range(wi.shape[0]):
-        for ch in range(P.shape[0]):
-            out[j, ch] = kernel(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2],
-                                P[ch])
+#: :func:`brdfkit.models.eval_pairs` for the analyses: serial (cheaper to compile: ~0.3 s
+#: per model instead of ~1 s for a prange loop), no direction checks (the analyses build
+#: unit directions); the plain loop of models/_drivers with the kernel an argument.
+_eval_pairs_serial = generic_loop("plain", parallel=False)
 
 
 def evaluate_pairs(model, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
@@ -467,12 +443,12 @@ def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
     if isinstance(model, BRDF):
         if model.kernel is not None:
             P = np.ascontiguousarray(np.asarray(model.packed, dtype=np.float64))
-            kernel = model.kernel
+            nodes = loop_driver(model.kernel, loop="albedo")
 
             def evaluate(th, offsets, wo):
                 vals = np.empty((wo.shape[0], P.shape[0]))
                 bad = np.zeros(th.size, dtype=np.int64)
-                _eval_kernel(kernel, P, th, offsets, wo, vals, bad)
+                nodes(P, th, offsets, wo, vals, bad)
                 return vals, bad
 
             n_channels = P.shape[0]

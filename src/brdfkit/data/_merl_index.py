@@ -5,9 +5,11 @@ The MERL lookup's index arithmetic, compiled
 The half/difference angles of a direction pair as MERL's reference reader
 (``BRDFRead.cpp``) computes them, its bin index formulas, a fast nearest
 index that gives the same indices without acos/atan2, and the trilinear cell
-of the ``linear`` lookup. Used by :mod:`brdfkit.data.merl` (formats, the
-drivers and :class:`~brdfkit.data.measured.MeasuredBRDF`); see its docstring for
-the formulas and [Matusik2003], [Rusinkiewicz1998].
+of the ``linear`` lookup, and the table loops of
+:class:`~brdfkit.data.measured.MeasuredBRDF` (:func:`_table_driver`: the blocked loop
+of :mod:`brdfkit.models._drivers` with this module's hooks). Used by
+:mod:`brdfkit.data.merl`; see its docstring for the formulas and [Matusik2003],
+[Rusinkiewicz1998].
 
 The fast nearest index (:func:`_fast_index`)
 --------------------------------------------
@@ -39,6 +41,7 @@ import numba
 import numpy as np
 
 from brdfkit._cache import memo
+from brdfkit.models._drivers import _unit_pair, blocked_driver, loop_driver
 
 
 @numba.njit(cache=True, inline="always")
@@ -282,20 +285,35 @@ def _index_tables() -> np.ndarray:
     return Q
 
 
-@numba.njit(cache=True, parallel=True)
-def _indices(wi, wo, Q, out):  # pragma: no cover - compiled
-    for j in numba.prange(wi.shape[0]):
-        hz, dx, dy, dz = _half_diff_vec(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1],
-                                        wo[j, 2])
-        out[j] = _fast_index(hz, dx, dy, dz, Q)
+# inline="always": inlined into the loop's prange body, which Numba compiles with the NumPy
+# error model (a division by 0 gives inf, no exception), as the former hand-written loops
+@numba.njit(cache=True, inline="always")
+def _index_kernel(ix, iy, iz, ox, oy, oz, Q):
+    """The fast nearest index of one pair (exact as a float64: < 2^53), a kernel of the
+    plain loop (models/_drivers) over packed row Q (:func:`_index_tables`)."""
+    hz, dx, dy, dz = _half_diff_vec(ix, iy, iz, ox, oy, oz)
+    return float(_fast_index(hz, dx, dy, dz, Q))
 
 
-@numba.njit(cache=True, parallel=True)
-def _indices_formula(wi, wo, out):  # pragma: no cover - compiled
+@numba.njit(cache=True, inline="always")
+def _index_formula_kernel(ix, iy, iz, ox, oy, oz, q):
     """The index from the angles (acos, atan2), as the reference: the fast path's check."""
-    for j in numba.prange(wi.shape[0]):
-        th, td, pd = _half_diff(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2])
-        out[j] = _nearest_index(th, td, pd)
+    th, td, pd = _half_diff(ix, iy, iz, ox, oy, oz)
+    return float(_nearest_index(th, td, pd))
+
+
+def _indices(wi, wo, Q, out) -> None:
+    """out[j] = the fast nearest index of pair j (int64), through the generated plain loop."""
+    col = np.empty((wi.shape[0], 1))
+    loop_driver(_index_kernel, loop="plain")(wi, wo, Q.reshape(1, -1), col)
+    out[:] = col[:, 0]
+
+
+def _indices_formula(wi, wo, out) -> None:
+    """out[j] = the index from the angles (:func:`_nearest_index`), the plain loop."""
+    col = np.empty((wi.shape[0], 1))
+    loop_driver(_index_formula_kernel, loop="plain")(wi, wo, np.empty((1, 0)), col)
+    out[:] = col[:, 0]
 
 
 @numba.njit(cache=True, inline="always")
@@ -349,3 +367,113 @@ def _linear(t, stride, offset, theta_h, theta_d, phi_d):
     C) (:func:`_linear_coords`, :func:`_linear_sum`)."""
     k0, step, th, td, tp = _linear_coords(theta_h, theta_d, phi_d)
     return _linear_sum(t, stride, offset, k0, step, th, td, tp)
+
+
+# --------------------------------------------------------------------------- table loops
+#: Pairs per task of the table drivers: the bins of a block are found first (arithmetic),
+#: then read (random reads of a 35 MB table, cache and TLB misses): the reads of a block
+#: are independent, so the memory system serves many at once (measured on this 2-core
+#: machine: 1.7-2.2x one loop that finds and reads each pair's bin in turn).
+_BLOCK = 256
+_BAD, _BELOW = -2, -1  # block markers: not a finite unit pair; below the horizon
+
+
+@numba.njit(cache=True, inline="always")
+def _status(ix, iy, iz, ox, oy, oz):
+    """0 for a pair to look up, _BAD (not finite unit vectors), _BELOW (f_r = 0)."""
+    if not _unit_pair(ix, iy, iz, ox, oy, oz):
+        return _BAD
+    if iz <= 0.0 or oz <= 0.0:
+        return _BELOW
+    return 0
+
+
+@numba.njit(cache=True, inline="always")
+def _fill(out, j, n_channels, status):
+    """Row j of a pair that is not looked up: NaN (bad) or 0 (below the horizon)."""
+    v = math.nan if status == _BAD else 0.0
+    for c in range(n_channels):
+        out[j, c] = v
+
+
+# The table loops of MeasuredBRDF.eval: the blocked loop of models/_drivers (locate a block
+# of pairs, then read it), generated with these hooks and cached on disk. ``data`` (flat):
+# the index tables (:func:`_index_tables`, _NQ numbers; _fast_index reads them by absolute
+# index, so the whole array is passed), then the channel-interleaved table (bin i, channel c
+# at ``_NQ + C·i + c``): the bin is found once per pair for all channels, whose values share
+# a cache line (the checked loop around :func:`_measured_kernel` finds it per channel and
+# reads three planar rows: ~3 cache and TLB misses per random pair). Both return the number
+# of pairs that are not finite unit vectors (their rows NaN), as the checked loop does.
+@numba.njit(cache=True, inline="always")
+def _nearest_state():
+    return np.empty(_BLOCK, dtype=np.int64)  # the pair's bin, or a marker
+
+
+@numba.njit(cache=True, inline="always")
+def _nearest_pair(k, t, ix, iy, iz, ox, oy, oz, data):
+    s = _status(ix, iy, iz, ox, oy, oz)
+    if s == 0:
+        hz, dx, dy, dz = _half_diff_vec(ix, iy, iz, ox, oy, oz)
+        k[t] = _fast_index(hz, dx, dy, dz, data)
+    else:
+        k[t] = s
+
+
+@numba.njit(cache=True, inline="always")
+def _nearest_emit(k, t, data, out, j):
+    n_channels = out.shape[1]
+    kj = k[t]
+    if kj >= 0:
+        base = _NQ + n_channels * kj
+        for c in range(n_channels):
+            out[j, c] = data[base + c]
+        return 0
+    _fill(out, j, n_channels, kj)
+    return 1 if kj == _BAD else 0
+
+
+@numba.njit(cache=True, inline="always")
+def _linear_state():
+    # per pair: the cell's first corner (or a marker), the φ_d step, the fractions (t_h,
+    # t_d, t_p); one array (a tuple of arrays built in an inlined hook crashed Numba's
+    # parallel lowering), the two integers held exactly as floats (< 2^53)
+    return np.empty((_BLOCK, 5))
+
+
+@numba.njit(cache=True, inline="always")
+def _linear_pair(state, t, ix, iy, iz, ox, oy, oz, data):
+    s = _status(ix, iy, iz, ox, oy, oz)
+    if s == 0:
+        theta_h, theta_d, phi_d = _half_diff(ix, iy, iz, ox, oy, oz)
+        k, step, th, td, tp = _linear_coords(theta_h, theta_d, phi_d)
+        state[t, 0] = k
+        state[t, 1] = step
+        state[t, 2] = th
+        state[t, 3] = td
+        state[t, 4] = tp
+    else:
+        state[t, 0] = s
+
+
+@numba.njit(cache=True, inline="always")
+def _linear_emit(state, t, data, out, j):
+    n_channels = out.shape[1]
+    k = int(state[t, 0])
+    if k >= 0:
+        step = int(state[t, 1])
+        for c in range(n_channels):
+            out[j, c] = _linear_sum(data, n_channels, _NQ + c, k, step,
+                                    state[t, 2], state[t, 3], state[t, 4])
+        return 0
+    _fill(out, j, n_channels, k)
+    return 1 if k == _BAD else 0
+
+
+_TABLE_HOOKS = {"nearest": (_nearest_state, _nearest_pair, _nearest_emit),
+                "linear": (_linear_state, _linear_pair, _linear_emit)}
+
+
+def _table_driver(lookup: str):
+    """The blocked loop of lookup *lookup* (``"nearest"`` or ``"linear"``), generated once."""
+    state, pair, emit = _TABLE_HOOKS[lookup]
+    return blocked_driver(state=state, pair=pair, emit=emit, block=_BLOCK)

@@ -298,6 +298,8 @@ def normal_albedo(model, *, n: int = 2048) -> np.ndarray:
     ``tests/test_albedo.py`` checks it against the engine to its stated 1e-4.
     """
     u = (np.arange(n) + 0.5) / n
+    # MERL's θ_h grid (geometry.merl_theta_h) in its own rounding order, kept so that the
+    # albedos `brdfkit materials` and `export --json` print stay bit for bit the same
     theta = 0.5 * math.pi * u * u
     jac = math.pi * u  # dθ/du
     wo = np.stack([np.sin(theta), np.zeros(n), np.cos(theta)], axis=-1)

@@ -26,19 +26,16 @@ import numpy as np
 
 from brdfkit.data._merl_index import (
     _NQ,
-    _fast_index,
     _half_diff,
-    _half_diff_vec,
     _index_tables,
     _linear,
-    _linear_coords,
-    _linear_sum,
     _nearest_index,
+    _table_driver,
 )
 from brdfkit.data.merl import N_BINS, SHAPE, MerlTable, bin_centres
 from brdfkit.data.sampler import TabulatedSampler
 from brdfkit.errors import ParameterError
-from brdfkit.models._base import DerivedBRDF, Lobe, Param, _unit_pair
+from brdfkit.models._base import DerivedBRDF, Lobe, Param
 
 __all__ = ["MeasuredBRDF"]
 
@@ -57,108 +54,6 @@ def _measured_kernel(ix, iy, iz, ox, oy, oz, p):
     if p[0] == LINEAR:
         return _linear(p, 1, _TABLE, theta_h, theta_d, phi_d)
     return p[_TABLE + _nearest_index(theta_h, theta_d, phi_d)]
-
-
-#: Pairs per task of the table drivers: the bins of a block are found first (arithmetic),
-#: then read (random reads of a 35 MB table, cache and TLB misses): the reads of a block
-#: are independent, so the memory system serves many at once (measured on this 2-core
-#: machine: 1.7-2.2x one loop that finds and reads each pair's bin in turn).
-_BLOCK = 256
-_BAD, _BELOW = -2, -1  # block markers: not a finite unit pair; below the horizon
-
-
-@numba.njit(cache=True, inline="always")
-def _status(ix, iy, iz, ox, oy, oz):
-    """0 for a pair to look up, _BAD (not finite unit vectors), _BELOW (f_r = 0)."""
-    if not _unit_pair(ix, iy, iz, ox, oy, oz):
-        return _BAD
-    if iz <= 0.0 or oz <= 0.0:
-        return _BELOW
-    return 0
-
-
-@numba.njit(cache=True, inline="always")
-def _fill(out, j, n_channels, status):
-    """Row j of a pair that is not looked up: NaN (bad) or 0 (below the horizon)."""
-    v = math.nan if status == _BAD else 0.0
-    for c in range(n_channels):
-        out[j, c] = v
-
-
-@numba.njit(cache=True, parallel=True)
-def _nearest_driver(wi, wo, data, out):  # pragma: no cover - compiled
-    """:meth:`BRDF.eval`'s checked pass for the ``nearest`` lookup. ``data`` (flat): the
-    index tables (:func:`_index_tables`, _NQ numbers), then the channel-interleaved table
-    (bin i, channel c at ``_NQ + C·i + c``): the bin is found once per pair for all
-    channels, whose values share a cache line (the generic loop around
-    :func:`_measured_kernel` finds it per channel and reads three planar rows: ~3 cache
-    and TLB misses per random pair). Blocks of _BLOCK pairs. Returns the number of pairs
-    that are not finite unit vectors (their rows NaN), as the generic driver does."""
-    n = wi.shape[0]
-    n_channels = out.shape[1]
-    Q = data[:_NQ]
-    n_bad = 0
-    for q in numba.prange((n + _BLOCK - 1) // _BLOCK):
-        lo = q * _BLOCK
-        hi = min(n, lo + _BLOCK)
-        k = np.empty(_BLOCK, dtype=np.int64)  # the bin's offset in data, or a marker
-        for j in range(lo, hi):
-            ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
-            ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-            s = _status(ix, iy, iz, ox, oy, oz)
-            if s == 0:
-                hz, dx, dy, dz = _half_diff_vec(ix, iy, iz, ox, oy, oz)
-                k[j - lo] = _NQ + n_channels * _fast_index(hz, dx, dy, dz, Q)
-            else:
-                k[j - lo] = s
-        for j in range(lo, hi):
-            kj = k[j - lo]
-            if kj >= 0:
-                for c in range(n_channels):
-                    out[j, c] = data[kj + c]
-            else:
-                _fill(out, j, n_channels, kj)
-                if kj == _BAD:
-                    n_bad += 1
-    return n_bad
-
-
-@numba.njit(cache=True, parallel=True)
-def _linear_driver(wi, wo, data, out):  # pragma: no cover - compiled
-    """:func:`_nearest_driver` for the ``linear`` lookup (the same ``data``): the cell and
-    weights are computed once per pair for all channels."""
-    n = wi.shape[0]
-    n_channels = out.shape[1]
-    n_bad = 0
-    for q in numba.prange((n + _BLOCK - 1) // _BLOCK):
-        lo = q * _BLOCK
-        hi = min(n, lo + _BLOCK)
-        k = np.empty(_BLOCK, dtype=np.int64)  # the cell's first corner, or a marker
-        step = np.empty(_BLOCK, dtype=np.int64)
-        frac = np.empty((_BLOCK, 3))
-        for j in range(lo, hi):
-            ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
-            ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-            s = _status(ix, iy, iz, ox, oy, oz)
-            if s == 0:
-                theta_h, theta_d, phi_d = _half_diff(ix, iy, iz, ox, oy, oz)
-                i = j - lo
-                k[i], step[i], frac[i, 0], frac[i, 1], frac[i, 2] = _linear_coords(
-                    theta_h, theta_d, phi_d)
-            else:
-                k[j - lo] = s
-        for j in range(lo, hi):
-            i = j - lo
-            if k[i] >= 0:
-                for c in range(n_channels):
-                    out[j, c] = _linear_sum(data, n_channels, _NQ + c, k[i], step[i],
-                                            frac[i, 0], frac[i, 1], frac[i, 2])
-            else:
-                _fill(out, j, n_channels, k[i])
-                if k[i] == _BAD:
-                    n_bad += 1
-    return n_bad
-
 
 
 def _width_from_table(values: np.ndarray) -> float:
@@ -286,8 +181,7 @@ class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
             isotropic=_mirror_symmetric(values))
         self.n_channels = 3
         # one bin computation per pair for all channels
-        self._driver = (_linear_driver if self._values["lookup"] == "linear"
-                        else _nearest_driver)
+        self._driver = _table_driver(self._values["lookup"])
 
     def _pack(self) -> np.ndarray:
         mode = LINEAR if self._values["lookup"] == "linear" else NEAREST
@@ -297,8 +191,8 @@ class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
         return out
 
     def _driver_data(self) -> np.ndarray:
-        """What :func:`_nearest_driver` and :func:`_linear_driver` read (built once): the
-        index tables, then the channel-interleaved table."""
+        """What the table loops (:func:`~brdfkit.data._merl_index._table_driver`) read
+        (built once): the index tables, then the channel-interleaved table."""
         if self._interleaved is None:
             t = np.empty(_NQ + 3 * N_BINS)
             t[:_NQ] = _index_tables()

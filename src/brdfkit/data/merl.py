@@ -71,6 +71,7 @@ from brdfkit.data._merl_index import (
     _indices_formula,
 )
 from brdfkit.errors import DataFileError, ParameterError
+from brdfkit.geometry import merl_theta_h
 
 __all__ = ["MerlTable", "read_binary", "write_binary", "merl_indices", "table_from_function",
            "bin_centres", "half_diff_to_directions", "SCALES", "SHAPE", "N_BINS"]
@@ -226,7 +227,7 @@ def bin_centres() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """θ_h, θ_d, φ_d at the bin centres (radians): the index coordinates i + ½ mapped back
     (θ_h = (u/90)²·π/2 — MERL's quadratic spacing), shapes (90,), (90,), (180,)."""
     u = np.arange(90) + 0.5
-    theta_h = (u / 90.0) ** 2 * (0.5 * np.pi)
+    theta_h = merl_theta_h(u / 90.0)
     theta_d = u / 90.0 * (0.5 * np.pi)
     phi_d = (np.arange(180) + 0.5) / 180.0 * np.pi
     return theta_h, theta_d, phi_d

@@ -46,8 +46,8 @@ Public objects
 - :func:`nbrdf_material`, :func:`npf_material`, :func:`abc_material`,
   :func:`sgd_material` — build one from its fitted numbers.
 - Kernels: :func:`nbrdf_kernel`, :func:`npf_kernel`, :func:`abc_kernel`,
-  :func:`sgd_kernel`; :func:`nbrdf_driver` (all three channels from one
-  network evaluation, blocked over pairs).
+  :func:`sgd_kernel` (each run by its generated checked loop, cached on disk);
+  :func:`nbrdf_driver` (NBRDF: all channels from one net evaluation, in blocks).
 
 References
 ----------
@@ -92,8 +92,7 @@ from brdfkit.fresnel import _fresnel_dielectric
 from brdfkit.models._base import _unit_pair
 
 __all__ = ["SurrogateBRDF", "nbrdf_material", "npf_material", "abc_material", "sgd_material",
-           "nbrdf_kernel", "nbrdf_driver", "npf_kernel", "npf_driver", "abc_kernel",
-           "abc_driver", "sgd_kernel", "sgd_driver",
+           "nbrdf_kernel", "nbrdf_driver", "npf_kernel", "abc_kernel", "sgd_kernel",
            "CITATIONS", "LICENCES", "REPRESENTATIONS"]
 
 _jit = numba.njit(cache=True, inline="always")
@@ -314,25 +313,6 @@ def npf_kernel(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
     return (p[0] + spec) * INV_PI
 
 
-# Each family has its own compiled loop (its ``_driver``), cached on disk: the generic
-# eval_pairs_checked is specialised per kernel at run time (not cacheable: keyed on the
-# dispatcher), which cost 7-8 s per family per process on this loaded 2-core machine.
-# The loop is eval_pairs_checked's, written out per kernel so that the kernel is a global
-# (inlined by LLVM) and the function can be cached.
-@numba.njit(cache=True, parallel=True)
-def npf_driver(wi, wo, P, out):  # pragma: no cover - compiled
-    """:func:`~brdfkit.models.eval_pairs_checked` for :func:`npf_kernel`."""
-    n_bad = 0
-    for j in numba.prange(wi.shape[0]):
-        ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
-        ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-        ok = _unit_pair(ix, iy, iz, ox, oy, oz)
-        for c in range(P.shape[0]):
-            out[j, c] = npf_kernel(ix, iy, iz, ox, oy, oz, P[c]) if ok else math.nan
-        if not ok:
-            n_bad += 1
-    return n_bad
-
 def npf_packed(row) -> np.ndarray:
     """Packed rows (3, 272) from one material's row of the NPF file, shape (512, 3)."""
     a = np.asarray(row, dtype=np.float64)
@@ -361,21 +341,6 @@ def abc_kernel(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
     F = _fresnel_dielectric(cos_d, p[4])
     return (p[0] + F * D * G / (iz * oz)) * INV_PI
 
-
-# the family's cached loop (see npf_driver)
-@numba.njit(cache=True, parallel=True)
-def abc_driver(wi, wo, P, out):  # pragma: no cover - compiled
-    """:func:`~brdfkit.models.eval_pairs_checked` for :func:`abc_kernel`."""
-    n_bad = 0
-    for j in numba.prange(wi.shape[0]):
-        ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
-        ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-        ok = _unit_pair(ix, iy, iz, ox, oy, oz)
-        for c in range(P.shape[0]):
-            out[j, c] = abc_kernel(ix, iy, iz, ox, oy, oz, P[c]) if ok else math.nan
-        if not ok:
-            n_bad += 1
-    return n_bad
 
 # --------------------------------------------------------------------------- SGD
 #: Packed SGD row (one channel): [ρ_d, ρ_s, α, p, F₀, F₁, K, Λ, c, k, θ₀].
@@ -422,20 +387,6 @@ def sgd_kernel(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
     return (p[0] + p[1] * F * D * G / (iz * oz)) * INV_PI
 
 
-# the family's cached loop (see npf_driver)
-@numba.njit(cache=True, parallel=True)
-def sgd_driver(wi, wo, P, out):  # pragma: no cover - compiled
-    """:func:`~brdfkit.models.eval_pairs_checked` for :func:`sgd_kernel`."""
-    n_bad = 0
-    for j in numba.prange(wi.shape[0]):
-        ix, iy, iz = wi[j, 0], wi[j, 1], wi[j, 2]
-        ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-        ok = _unit_pair(ix, iy, iz, ox, oy, oz)
-        for c in range(P.shape[0]):
-            out[j, c] = sgd_kernel(ix, iy, iz, ox, oy, oz, P[c]) if ok else math.nan
-        if not ok:
-            n_bad += 1
-    return n_bad
 
 
 # --------------------------------------------------------------------------- builders
@@ -451,7 +402,7 @@ def npf_material(material: str, row) -> SurrogateBRDF:
     packed = npf_packed(row)
     return SurrogateBRDF(source="merl", material=material, representation="npf",
                          kernel=npf_kernel, packed=packed, reciprocal=True,
-                         driver=npf_driver, rho_d=packed[:, 0].copy())
+                         rho_d=packed[:, 0].copy())
 
 
 def abc_material(material: str, kD, A, B: float, C: float, ior: float) -> SurrogateBRDF:
@@ -463,7 +414,6 @@ def abc_material(material: str, kD, A, B: float, C: float, ior: float) -> Surrog
         raise ParameterError(f"ABC fit of {material!r}: expected finite parameters and ior > 0")
     return SurrogateBRDF(source="merl", material=material, representation="abc",
                          kernel=abc_kernel, packed=packed, reciprocal=True, rho_d=kD.copy(),
-                         driver=abc_driver,
                          albedo_kinks=frozenset({"vgroove"}))
 
 
@@ -478,5 +428,5 @@ def sgd_material(material: str, fields: dict) -> SurrogateBRDF:
         raise ParameterError(f"SGD fit of {material!r}: NaN or infinite parameters")
     return SurrogateBRDF(source="merl", material=material, representation="sgd",
                          kernel=sgd_kernel, packed=packed, reciprocal=True,
-                         driver=sgd_driver, rho_d=packed[:, 0].copy(),
+                         rho_d=packed[:, 0].copy(),
                          kink_theta0=packed[:, 10].copy())

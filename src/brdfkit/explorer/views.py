@@ -33,14 +33,14 @@ import math
 import numpy as np
 
 from brdfkit.analysis import albedo, check
+from brdfkit.colour import LUMINANCE
 from brdfkit.errors import ParameterError
-from brdfkit.geometry import from_rusinkiewicz
+from brdfkit.geometry import from_rusinkiewicz, merl_theta_h
 
 __all__ = ["polar", "lobe", "curves", "halfdiff", "sphere", "albedo_curve", "verdict",
            "channels", "png_bytes", "ALBEDO_TOL", "VERDICT_TOL", "LUMINANCE"]
 
-#: Rec. 709 / sRGB luminance weights of linear R, G, B.
-LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+#: Rec. 709 / sRGB luminance weights of linear R, G, B (re-exported from brdfkit.colour).
 #: Absolute accuracy of the live albedo curve: below a pixel of a 0–1 plot a few hundred
 #: pixels high, and 10-100x cheaper than the engine's 1e-7 default on glossy lobes.
 ALBEDO_TOL = 1e-4
@@ -135,7 +135,7 @@ def halfdiff(model, *, size: int = 90, phi_d: float = 0.5 * math.pi, decades: fl
     """θ_h (rows, downward) × θ_d (columns) image of log₁₀ f (luminance), the top
     *decades* mapped to the colour scale; returns (PNG bytes, {"vmin", "vmax"})."""
     u = (np.arange(size) + 0.5) / size
-    th = u * u * 0.5 * math.pi  # MERL's quadratic θ_h spacing: detail near the peak
+    th = merl_theta_h(u)  # MERL's quadratic θ_h spacing: detail near the peak
     td = u * 0.5 * math.pi
     TH, TD = np.meshgrid(th, td, indexing="ij")
     wi, wo = from_rusinkiewicz(TH.ravel(), np.zeros(TH.size), TD.ravel(),

@@ -80,6 +80,7 @@ import numpy as np
 from brdfkit._cache import memo
 from brdfkit.data.merl import SHAPE, half_diff_to_directions
 from brdfkit.errors import ParameterError
+from brdfkit.geometry import merl_theta_h
 
 __all__ = ["Samples", "bin_measure", "merl_samples", "albedo_nodes", "albedo_from_values",
            "albedo_with_error", "DEFAULT_STRIDES", "ALBEDO_THETA_DEG", "ALBEDO_NODES",
@@ -99,7 +100,7 @@ ALBEDO_COARSENING = 3
 def _edges():
     """Bin edges (radians) along θ_h (quadratic), θ_d and φ_d."""
     u = np.arange(SHAPE[0] + 1) / SHAPE[0]
-    h = u * u * (0.5 * math.pi)
+    h = merl_theta_h(u)
     d = np.arange(SHAPE[1] + 1) / SHAPE[1] * (0.5 * math.pi)
     p = np.arange(SHAPE[2] + 1) / SHAPE[2] * math.pi
     return h, d, p
@@ -212,7 +213,7 @@ def albedo_nodes(theta_deg=ALBEDO_THETA_DEG, *, n_u: int = 48, n_phi: int = 24):
 def _albedo_nodes(theta_deg: tuple, n_u: int, n_phi: int):
     theta = np.radians(np.asarray(theta_deg, dtype=np.float64))
     u = (np.arange(n_u) + 0.5) / n_u
-    th = u * u * (0.5 * math.pi)
+    th = merl_theta_h(u)
     dth = math.pi * u / n_u  # dθ_h = π u du
     ph = (np.arange(n_phi) + 0.5) / n_phi * math.pi
     dph = 2.0 * math.pi / n_phi  # [0, π] doubled

@@ -12,11 +12,15 @@ One module per family; every model is registered in :data:`MODELS`.
 - :mod:`~brdfkit.models.lafortune` — Lafortune's generalised cosine lobes.
 - :mod:`~brdfkit.models.grazing` — Neumann et al.'s eq. (22) and Nielsen et
   al.'s eq. (3), Phong variants for grazing angles.
-- :mod:`~brdfkit.models.microfacet` — Torrance–Sparrow, Cook–Torrance, Ward,
-  He–Torrance and the modern Walter et al. microfacet model.
+- :mod:`~brdfkit.models.microfacet` — the Walter et al. microfacet model;
+  :mod:`~brdfkit.models.vgroove` — Torrance–Sparrow and Cook–Torrance;
+  :mod:`~brdfkit.models.ward` — Ward; :mod:`~brdfkit.models.he_torrance` —
+  He–Torrance–Sillion–Greenberg.
 
 Shared by the families: :mod:`~brdfkit.models.sampling` (importance-sampling
-strategies), :mod:`~brdfkit.models.specular` (Lewis's H_s).
+strategies), :mod:`~brdfkit.models.specular` (Lewis's H_s),
+:mod:`~brdfkit.models._params` (parameters declared once), :mod:`~brdfkit.models._drivers`
+(the one loop generator).
 """
 
 from brdfkit.models._base import BRDF, DerivedBRDF, Lobe, Param, eval_pairs
@@ -25,7 +29,8 @@ from brdfkit.models._registry import MODELS, model, model_names, register, resol
 # Importing the family modules registers their models, in this order: the order of
 # `brdfkit models`, of the README's model table and of Table 2.
 # isort: off
-from brdfkit.models import diffuse, phong, blinn, lafortune, grazing, microfacet  # noqa: E402,F401,I001
+from brdfkit.models import diffuse, phong, blinn, lafortune, grazing  # noqa: E402,F401,I001
+from brdfkit.models import microfacet, vgroove, ward, he_torrance  # noqa: E402,F401,I001
 # isort: on
 
 __all__ = ["BRDF", "DerivedBRDF", "Lobe", "MODELS", "Param", "eval_pairs", "model", "model_names",

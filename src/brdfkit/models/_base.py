@@ -30,7 +30,7 @@ Public objects
 - :class:`DerivedBRDF` — the one constructor path for models built from others.
 - :func:`eval_pairs`, :func:`eval_pairs_checked`, :func:`checked_driver` — the
   compiled loops over all pairs, defined in :mod:`brdfkit.models._drivers` and
-  imported here (the loop :meth:`BRDF.eval` runs: :func:`~brdfkit.models._drivers.cached_driver`).
+  imported here (the loop :meth:`BRDF.eval` runs: :func:`~brdfkit.models._drivers.loop_driver`).
 """
 
 from __future__ import annotations
@@ -54,6 +54,7 @@ from brdfkit.models._drivers import (  # noqa: F401  (re-exported: models import
     checked_driver,
     eval_pairs,
     eval_pairs_checked,
+    loop_driver,
 )
 from brdfkit.models._param import (  # noqa: F401  (re-exported: models import them here)
     Lobe,
@@ -164,7 +165,8 @@ class BRDF:
     #: unpumped root.
     fit_base: BRDF | None = None
     #: Compiled loop specialised to ``kernel`` (:func:`checked_driver`), or None for the
-    #: generic :func:`eval_pairs_checked` (a composite kernel, e.g. pumped, sets one).
+    #: checked loop generated for ``kernel`` (:func:`loop_driver`; a composite or table
+    #: kernel, e.g. pumped or measured, sets one).
     _driver: Callable | None = None
 
     # ------------------------------------------------------------------ set-up
@@ -390,17 +392,14 @@ class BRDF:
         wi2 = np.ascontiguousarray(wi).reshape(-1, 3)
         wo2 = np.ascontiguousarray(wo).reshape(-1, 3)
         out = np.empty((wi2.shape[0], self._packed.shape[0]))
-        driver = self._driver
-        # fewer than SERIAL_BELOW pairs: one thread (waking the pool costs more than the work)
+        # the model's own loop, else the checked loop generated for its kernel (cached on
+        # disk: models/_drivers.py); small calls on this thread alone (SERIAL_BELOW)
+        if self._driver is not None:
+            driver, data = self._driver, self._driver_data()
+        else:
+            driver, data = loop_driver(self.kernel), self._packed
         with numba_threads(1 if wi2.shape[0] < SERIAL_BELOW else None):
-            if driver is not None:
-                n_bad = driver(wi2, wo2, self._driver_data(), out)
-            else:
-                # the generic loop, compiled once per kernel and kept on disk when the
-                # kernel has an importable name (models/_drivers.py)
-                cached = cached_driver(self.kernel)
-                n_bad = (cached(wi2, wo2, self._packed, out) if cached is not None
-                         else eval_pairs_checked(self.kernel, wi2, wo2, self._packed, out))
+            n_bad = driver(wi2, wo2, data, out)
         if n_bad:
             as_directions(wi_in, "wi")  # raises the usual BrdfkitError for NaN/inf
             as_directions(wo_in, "wo")

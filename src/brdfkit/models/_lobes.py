@@ -29,12 +29,13 @@ import numpy as np
 
 from brdfkit.halfangle import beta_from_exponent, exponent_from_beta
 from brdfkit.models._base import BRDF, Lobe, Param
+from brdfkit.models._params import DIFFUSE_PART
 from brdfkit.models.sampling import COSINE, Mixture, StrategySampled, blinn_lobe, normalised_weights
 from brdfkit.models.specular import blinn_normal_albedo
 
 __all__ = ["COS_DIVISOR_FLOOR", "CosineLobeBRDF", "lobe_pow"]
 
-RHO_D = Param("rho_d", 0.2, 0.0, 1.0, "", "diffuse albedo", kind="colour")
+RHO_D = DIFFUSE_PART  # ρ_d of the diffuse part beside a lobe (models/_params.py)
 RHO_S = Param("rho_s", 0.5, 0.0, 1.0, "",
               "specular reflectance (albedo of the normalised lobe at normal incidence)",
               kind="colour")

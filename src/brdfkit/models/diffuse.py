@@ -33,11 +33,9 @@ from brdfkit.halfangle import (
     neumann_s_from_beta,
 )
 from brdfkit.models._base import BRDF, Lobe, Param
+from brdfkit.models._params import DIFFUSE_ALBEDO
 from brdfkit.models._registry import register
 from brdfkit.models.sampling import CosPowerNormal, StrategySampled
-
-RHO_D = Param("rho_d", 0.8, 0.0, 1.0, "", "diffuse albedo (fraction of irradiance reflected)",
-              kind="colour")
 
 
 @numba.njit(cache=True)
@@ -64,7 +62,7 @@ class Lambert(BRDF):
     name = "lambert"
     aliases = ("diffuse", "lambertian")
     summary = "Lambertian diffuse: rho_d/pi"
-    params = (RHO_D,)
+    params = (DIFFUSE_ALBEDO,)
     citation = "Lambert 1760; Lewis 1993 eq. (8) with k_s = 0 (k_d = rho_d/pi)"
     reciprocal = True
     has_sampler = True

@@ -27,6 +27,7 @@ References
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numba
 import numpy as np
@@ -50,6 +51,7 @@ from brdfkit.models._lobes import (
     lobe_hint,
     lobe_pow,
 )
+from brdfkit.models._params import ETA, packed_indices
 from brdfkit.models._registry import register
 from brdfkit.models.sampling import COSINE, Mixture, blinn_lobe, normalised_weights, phong_lobe
 from brdfkit.models.specular import blinn_normal_albedo
@@ -137,11 +139,23 @@ class NeumannPhong(CosineLobeBRDF):
 
 
 # --------------------------------------------------------------------------- Nielsen eq. (3)
+NIELSEN_PARAMS = (
+    RHO_D,
+    Param("k_s", 2.0, 0.0, 1e6, "1/sr", "specular coefficient (~ rho_s (s+2)/2pi)",
+          kind="colour"),
+    Param("s", 20.0, 0.0, 1e6, "", "shininess exponent"),
+    Param("alpha", 0.5, 0.0, 1.0, "", "mix: 0 Phong (R.V), 1 Blinn-Phong (N.H)^4"),
+    replace(ETA, doc="refractive index; none: F = 1"),
+)
+N_RHO_D, N_K_S, N_S, N_ALPHA, N_ETA = packed_indices(
+    NIELSEN_PARAMS, "rho_d", "k_s", "s", "alpha", "eta")
+
+
 @numba.njit(cache=True)
 def _nielsen(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
-    rho_d, k_s, s, alpha, eta = p[0], p[1], p[2], p[3], p[4]
+    rho_d, k_s, s, alpha, eta = p[N_RHO_D], p[N_K_S], p[N_S], p[N_ALPHA], p[N_ETA]
     # One square root, one division: ω_h·n = (N·L + N·V)/|L + V|,
     # ω_i·ω_h = (1 + L·V)/|L + V| = |L + V|/2 and ω_r·ω_o = 2(N·L)(N·V) − L·V.
     # |L + V| comes from the components (not √(2 + 2 L·V), which rounds to 0 for
@@ -200,15 +214,7 @@ class Nielsen(CosineLobeBRDF):
     name = "nielsen"
     aliases = ("nielsen-2015", "nielsen-eq3", "nielsen-mixed")
     summary = "Nielsen et al. eq. (3): Fresnel-weighted mix of Phong and Blinn-Phong cosines"
-    params = (
-        RHO_D,
-        Param("k_s", 2.0, 0.0, 1e6, "1/sr", "specular coefficient (~ rho_s (s+2)/2pi)",
-              kind="colour"),
-        Param("s", 20.0, 0.0, 1e6, "", "shininess exponent"),
-        Param("alpha", 0.5, 0.0, 1.0, "", "mix: 0 Phong (R.V), 1 Blinn-Phong (N.H)^4"),
-        Param("eta", None, 0.0, 100.0, "", "refractive index; none: F = 1", kind="colour",
-              lower_open=True, optional=True),
-    )
+    params = NIELSEN_PARAMS
     citation = "Nielsen et al. eq. (3), Fresnel factor as in the text"
     fit_bound_starts = ("alpha",)  # α = 0: the Phong-like lobe, α = 1: the Blinn-like one
     reciprocal = True

@@ -21,6 +21,7 @@ from brdfkit.errors import ParameterError
 from brdfkit.fresnel import _fresnel_conductor
 from brdfkit.halfangle import beta_from_beckmann_m
 from brdfkit.models._base import BRDF, Lobe, Param
+from brdfkit.models._params import ETA, packed_indices
 from brdfkit.models._registry import register
 from brdfkit.models.microfacet_distributions import SQRT_PI, _HalfVectorSampling
 
@@ -138,11 +139,24 @@ def htsg_series(g: float, a: float) -> float:
     return total
 
 
+PARAMS = (
+    Param("sigma0", 0.1, 0.0, 10.0, "lambda", "RMS surface height in wavelengths",
+          lower_open=True),
+    Param("tau", 1.7, 0.0, 1000.0, "lambda", "autocorrelation length in wavelengths",
+          lower_open=True),
+    ETA,
+    Param("k", 0.0, 0.0, 100.0, "", "extinction coefficient (conductors)", kind="colour"),
+    Param("rho_d", 0.0, 0.0, 1.0, "", "uniform-diffuse albedo a(lambda)", kind="colour"),
+)
+P_SIGMA0, P_TAU, P_ETA, P_K, P_RHO_D = packed_indices(
+    PARAMS, "sigma0", "tau", "eta", "k", "rho_d")
+
+
 @numba.njit(cache=True)
 def _he_torrance(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
-    sigma0, tau, eta, kappa, rho_d = p[0], p[1], p[2], p[3], p[4]
+    sigma0, tau, eta, kappa, rho_d = p[P_SIGMA0], p[P_TAU], p[P_ETA], p[P_K], p[P_RHO_D]
     # v = k_r − k_i in units of 2π/λ (λ = 1): both directions point away, so v ∝ wi + wo.
     sx = ix + ox
     sy = iy + oy
@@ -247,16 +261,7 @@ class HeTorrance(_HalfVectorSampling, BRDF):
     name = "he-torrance"
     aliases = ("htsg", "he-torrance-sillion-greenberg")
     summary = "He-Torrance-Sillion-Greenberg 1991 (directional-diffuse + uniform-diffuse)"
-    params = (
-        Param("sigma0", 0.1, 0.0, 10.0, "lambda", "RMS surface height in wavelengths",
-              lower_open=True),
-        Param("tau", 1.7, 0.0, 1000.0, "lambda", "autocorrelation length in wavelengths",
-              lower_open=True),
-        Param("eta", None, 0.0, 100.0, "", "real part of the index of refraction; none: F = 1",
-              kind="colour", lower_open=True, optional=True),
-        Param("k", 0.0, 0.0, 100.0, "", "extinction coefficient (conductors)", kind="colour"),
-        Param("rho_d", 0.0, 0.0, 1.0, "", "uniform-diffuse albedo a(lambda)", kind="colour"),
-    )
+    params = PARAMS
     citation = ("He, Torrance, Sillion, Greenberg 1991 (rho_dd, rho_sp, sigma, S); "
                 "Neumann et al. 1999 Fig. 1 (sigma0 = 0.1, tau = 1.7)")
     has_delta = True  # the specular spike of eq. (5): specular_albedo

@@ -11,25 +11,55 @@ lookup for a whole chain"):
 - :func:`stage_kernel` — f_base / g for one stage, two albedo lookups, as
   eq. (20)/(21) is written.
 
-Each comes with its own compiled loop (:func:`brdfkit.models._base.checked_driver`)
-and is cached per (kernel, structure). :data:`G_NUMPY` holds the built-in g in
+Each is generated with its own compiled loop (:func:`brdfkit.models._drivers.composed`:
+the base kernel inlined, the module cached on disk, so the next process loads it) and
+memoised per (kernel, structure). :data:`G_NUMPY` holds the built-in g in
 NumPy for models evaluated without a kernel.
 """
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
-from brdfkit._cache import bounded_cache
-from brdfkit.models._base import checked_driver
+from brdfkit.models._drivers import composed
 from brdfkit.tables import _lookup
 
 __all__ = ["G_NUMPY", "chain_kernel", "stage_kernel"]
 
-#: (kernel, structure) → (kernel, driver): one per pumped structure in use (each a compiled
-#: kernel and loop, seconds to build; a session uses a few)
-_KERNELS = bounded_cache("brdfkit.pumping.kernels._KERNELS", maxsize=256)
+# The kernels' templates (models/_drivers.composed): plain functions whose globals below
+# are bound per composition — the base kernel, the compile-time table offset and flags —
+# and compiled, with their checked loop, into one generated module cached on disk.
+root_kernel = base_kernel = None  # a kernel (ix, iy, iz, ox, oy, oz, p) -> float
+k = depth = 0  # offsets into the packed row
+capped = controlled = False  # eq. (17) cap; controlled g (eq. 21)
+
+
+def _chain(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
+    f = root_kernel(ix, iy, iz, ox, oy, oz, p)  # 0 below the horizon
+    if f == 0.0:
+        return 0.0  # nothing to pump (outside the lobe, below the horizon)
+    q = _lookup(p, k, iz if iz > oz else oz)
+    if capped and q < 1.0:
+        q = 1.0  # eq. (17) g <= 1 for every stage
+    return f * q
+
+
+def _stage(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
+    f = base_kernel(ix, iy, iz, ox, oy, oz, p)  # 0 below the horizon
+    if f == 0.0:
+        return 0.0
+    off = int(p[p.shape[0] - depth])
+    a_i = _lookup(p, off, iz)
+    a_o = _lookup(p, off, oz)
+    g = a_i if a_i > a_o else a_o
+    if capped and g > 1.0:
+        g = 1.0  # eq. (17) g <= 1
+    if controlled:
+        if iz > g:
+            g = iz
+        if oz > g:
+            g = oz
+    return f / g
 
 
 def chain_kernel(root_kernel, k: int, capped: bool):
@@ -44,20 +74,7 @@ def chain_kernel(root_kernel, k: int, capped: bool):
     stage caps g at 1, so q ≥ 1 exactly (the lookup's margin may dip below 1
     where q = 1; raising it back keeps q̃ ≤ q because q ≥ 1 there).
     """
-    key = (root_kernel, "chain", k, capped)
-    if key not in _KERNELS:
-        @numba.njit(inline="always")  # inlined into its own driver (checked_driver)
-        def kernel(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
-            f = root_kernel(ix, iy, iz, ox, oy, oz, p)  # 0 below the horizon
-            if f == 0.0:
-                return 0.0  # nothing to pump (outside the lobe, below the horizon)
-            q = _lookup(p, k, iz if iz > oz else oz)
-            if capped and q < 1.0:
-                q = 1.0  # eq. (17) g <= 1 for every stage
-            return f * q
-
-        _KERNELS[key] = kernel, checked_driver(kernel)
-    return _KERNELS[key]
+    return composed(_chain, root_kernel=root_kernel, k=int(k), capped=bool(capped))
 
 
 def stage_kernel(base_kernel, controlled: bool, capped: bool, depth: int):
@@ -69,28 +86,8 @@ def stage_kernel(base_kernel, controlled: bool, capped: bool, depth: int):
     g ≤ 1 (eq. 17) is applied after the lookup (whose margin may exceed 1
     where a = 1).
     """
-    key = (base_kernel, "stage", controlled, capped, depth)
-    if key not in _KERNELS:
-        @numba.njit(inline="always")  # inlined into its own driver (checked_driver)
-        def kernel(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
-            f = base_kernel(ix, iy, iz, ox, oy, oz, p)  # 0 below the horizon
-            if f == 0.0:
-                return 0.0
-            off = int(p[p.shape[0] - depth])
-            a_i = _lookup(p, off, iz)
-            a_o = _lookup(p, off, oz)
-            g = a_i if a_i > a_o else a_o
-            if capped and g > 1.0:
-                g = 1.0  # eq. (17) g <= 1
-            if controlled:
-                if iz > g:
-                    g = iz
-                if oz > g:
-                    g = oz
-            return f / g
-
-        _KERNELS[key] = kernel, checked_driver(kernel)
-    return _KERNELS[key]
+    return composed(_stage, base_kernel=base_kernel, controlled=bool(controlled),
+                    capped=bool(capped), depth=int(depth))
 
 
 def _g_max(wi, wo, a_i, a_o):

@@ -56,13 +56,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from brdfkit.colour import MITSUBA_LUMINANCE
 from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
 
 __all__ = ["LUMINANCE", "RGB_GRID", "ColourMap", "check_wavelengths"]
 
 #: Rec. 709 luminance weights of linear sRGB (Mitsuba's ``luminance``; ITU-R BT.709).
-LUMINANCE = np.array([0.212671, 0.715160, 0.072169])
+LUMINANCE = MITSUBA_LUMINANCE  # brdfkit.colour: as Mitsuba's own conversion (traced route)
 
 
 def check_wavelengths(wavelengths, model: BRDF) -> np.ndarray | None:

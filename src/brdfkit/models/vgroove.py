@@ -1,0 +1,351 @@
+"""
+V-groove microfacet models: Torrance–Sparrow and Cook–Torrance
+==============================================================
+
+Two models of reflection from V-shaped grooves (masking-shadowing
+:func:`g_vgroove`), as Lewis and Neumann et al. write them; the facet
+distributions are those of :mod:`brdfkit.models.microfacet_distributions`.
+
+Public objects
+--------------
+- :class:`TorranceSparrow` — ``torrance-sparrow``: Lewis eq. (10) with D₁–D₄.
+- :class:`CookTorrance` — ``cook-torrance``: Neumann et al. eqs. (9)–(10).
+- :func:`g_vgroove` — the V-groove masking-shadowing factor.
+- :data:`DENOM_FLOOR` — the floor of the (N·L)(N·V) denominators.
+
+References
+----------
+- [Lewis1993] eq. (10) and D₁–D₄; [Neumann1999] eqs. (9)–(10).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+
+from brdfkit._kern import SMALL_LENGTH, below_horizon, half, pos_pow
+from brdfkit.errors import ParameterError
+from brdfkit.fresnel import _fresnel_dielectric
+from brdfkit.halfangle import (
+    beckmann_m_from_beta,
+    beta_from_beckmann_m,
+    beta_from_exponent,
+    beta_from_trowbridge_reitz_c,
+    exponent_from_beta,
+    gaussian_c_from_beta,
+    trowbridge_reitz_c_from_beta,
+)
+from brdfkit.models._base import BRDF, VECTOR_OPTIONS, Lobe, Param, _check_beta
+from brdfkit.models._params import ETA_DIELECTRIC, M_SLOPE, packed_indices
+from brdfkit.models._registry import register
+from brdfkit.models.microfacet_distributions import _HalfVectorSampling, beckmann_lobe
+
+__all__ = ["TorranceSparrow", "CookTorrance", "g_vgroove", "DENOM_FLOOR", "TS_PARAMS",
+           "CT_PARAMS"]
+
+_jit = numba.njit(cache=True, inline="always")
+# Compile options of the fast kernels: as VECTOR_OPTIONS (IEEE division, no fastmath).
+_FAST = VECTOR_OPTIONS["fastmath"]
+
+
+# =========================================================================== shared
+# Both directions within ~1e-140 of the horizon make (N·L)(N·V) underflow; the
+# denominators below are floored at DENOM_FLOOR so that f stays finite there
+# (it changes f only where both cosines are < 1e-140).
+DENOM_FLOOR = 1e-280
+
+
+@_jit
+def g_vgroove(n_h: float, n_l: float, n_v: float, v_h: float) -> float:
+    """V-groove masking-shadowing (Torrance–Sparrow; Lewis §3.2, Neumann eq. 10).
+
+    G = min{1, 2(N·H)(N·V)/(V·H), 2(N·H)(N·L)/(V·H)}; V·H = L·H for the bisector.
+    """
+    if v_h <= 0.0:
+        return 0.0  # L = −V (no bisector): nothing is reflected
+    return min(1.0, 2.0 * n_h * n_v / v_h, 2.0 * n_h * n_l / v_h)
+
+
+# =========================================================================== Torrance-Sparrow
+PHONG_D, GAUSSIAN_D, TR_D, BECKMANN_D = 0, 1, 2, 3
+_TS_DISTRIBUTIONS = ("phong", "gaussian", "trowbridge-reitz", "beckmann")
+_TS_WIDTH = {"phong": "n", "gaussian": "c", "trowbridge-reitz": "c", "beckmann": "m"}
+_TS_DEFAULT_C = {"gaussian": 4.0, "trowbridge-reitz": 0.3}  # both β ≈ 12°
+
+
+TS_PARAMS = (
+    Param("distribution", "beckmann", kind="choice", choices=_TS_DISTRIBUTIONS,
+          doc="facet slope distribution: phong (D1), gaussian (D2), trowbridge-reitz (D3), "
+              "beckmann (D4)"),
+    Param("b", 1.0, 0.0, 1e3, "", "scale of D1-D3 (Lewis's b; beckmann has none)"),
+    Param("n", 20.0, 0.0, 1e6, "", "exponent c1 of D1 (phong)"),
+    Param("c", None, 0.0, 1e3, "",
+          "c2 of D2 (gaussian, 1/rad, default 4) or c3 of D3 (trowbridge-reitz, <= 1, "
+          "default 0.3)", lower_open=True, optional=True),
+    M_SLOPE,
+    ETA_DIELECTRIC,
+)
+TS_DIST, TS_B, TS_N, TS_C, TS_M, TS_ETA = packed_indices(
+    TS_PARAMS, "distribution", "b", "n", "c", "m", "eta")
+
+
+@numba.njit(cache=True)
+def _torrance_sparrow(ix, iy, iz, ox, oy, oz, p):
+    if below_horizon(iz, oz):
+        return 0.0
+    dist, b, n, c, m, eta = p[TS_DIST], p[TS_B], p[TS_N], p[TS_C], p[TS_M], p[TS_ETA]
+    hx, hy, hz, length = half(ix, iy, iz, ox, oy, oz)
+    cos_vh = ox * hx + oy * hy + oz * hz  # = L·H
+    if dist == PHONG_D:
+        d = b * pos_pow(hz, n)  # D₁ = b cos^{c₁} α
+    elif dist == GAUSSIAN_D:
+        alpha = math.acos(min(hz, 1.0))  # clamp: rounding can give hz slightly > 1
+        d = b * math.exp(-(c * alpha) ** 2)  # D₂
+    elif dist == TR_D:
+        # D₃; the denominator is ≥ min(c², 1) > 0 unless c² underflows (c < 1e-154) at the
+        # exact bisector, where q = 1 is the limit (D₃ peaks at b for every c)
+        den = hz * hz * (c * c - 1.0) + 1.0
+        q = c * c / den if den > 0.0 else 1.0
+        d = b * q * q
+    else:
+        d = 0.25 * beckmann_lobe(hz, m) / (m * m)  # D₄ = e^{−tan²α/m²}/(4m² cos⁴α), no b
+    g = g_vgroove(hz, iz, oz, cos_vh)
+    f = 1.0 if eta == 0.0 else _fresnel_dielectric(cos_vh, eta)  # eta not given: F = 1
+    return f * g * d / (math.pi * max(iz * oz, DENOM_FLOOR))  # floor: see DENOM_FLOOR
+
+
+@register
+class TorranceSparrow(_HalfVectorSampling, BRDF):
+    """Torrance–Sparrow shader as formulated by Lewis, eq. (10).
+
+    f_r = F G D/(π (N·S)(N·V)), G the V-groove factor
+    min{1, 2(N·H)(N·V)/(V·H), 2(N·H)(N·S)/(V·H)}, F the dielectric Fresnel
+    of V·H (Cook & Torrance; F = 1 without ``eta``), and D one of
+    (cos α = N·H):
+
+    - ``phong``: D₁ = b cos^{n}α (Lewis's c₁ is ``n``),
+    - ``gaussian``: D₂ = b e^{−(cα)²} (c₂ is ``c``, in 1/rad),
+    - ``trowbridge-reitz``: D₃ = b [c²/(cos²α(c²−1)+1)]² (c₃ is ``c``),
+    - ``beckmann``: D₄ = e^{−tan²α/m²}/(4m² cos⁴α) (no b).
+
+    ============  ==========  ============  ========================================
+    name          default     bounds        meaning
+    ============  ==========  ============  ========================================
+    distribution  beckmann    see above     facet slope distribution D
+    b             1           [0, 1e3]      scale of D₁–D₃ (ignored by beckmann)
+    n             20          [0, 1e6]      c₁, exponent of D₁
+    c             None        (0, 1e3]      c₂ of D₂ (default 4) or c₃ of D₃
+                                            (default 0.3; must be ≤ 1 so that D₃
+                                            peaks at α = 0)
+    m             0.1         [1e-4, 100]   RMS slope of D₄
+    eta           None        (0, 100]      index of refraction; None: F = 1
+    ============  ==========  ============  ========================================
+
+    ``beta`` (half-angle, radians) sets the width of the chosen distribution
+    through :mod:`brdfkit.halfangle` (n, c₂, c₃ or m — Lewis §3.2).
+
+    With D₄ the model equals the Walter-normalised Beckmann microfacet BRDF
+    with V-groove G, F G D_B/(4 (N·S)(N·V)) with D_B = e^{−tan²α/m²}/(π m² cos⁴α):
+    Lewis's π in eq. (10) and the 4 in D₄ together make D normalised. D₁–D₃
+    carry Lewis's arbitrary b, so their albedo is not bounded by 1 in
+    general (Lewis Fig. 7). Reciprocal (Lewis §5.2). Sampled by the facet
+    distribution: cosⁿ lobe (D₁), Beckmann with m = 1/c (D₂, approximate
+    proposal, exact pdf), GGX with α = c (D₃, the same lobe), Beckmann (D₄).
+    """
+
+    name = "torrance-sparrow"
+    aliases = ("torrance", "lewis-torrance-sparrow")
+    summary = "Torrance-Sparrow F G D / (pi N.S N.V), D1-D4 of Lewis"
+    params = TS_PARAMS
+    citation = "Lewis 1993 eq. (10) with D1-D4 and G of §3.2 (after Cook & Torrance 1982)"
+    albedo_kinks = frozenset({"vgroove"})  # G of §3.2
+    reciprocal = True
+    has_sampler = True
+    width_param = "m"  # of the default distribution; per instance it follows `distribution`
+    kernel = _torrance_sparrow
+    examples = (
+        {},
+        {"m": 0.01},
+        {"distribution": "phong", "n": 2000.0},
+        {"distribution": "gaussian", "c": 40.0, "eta": 1.5},
+        {"distribution": "trowbridge-reitz", "c": 0.05},
+        {"distribution": "trowbridge-reitz", "b": 0.5, "c": 0.4, "eta": [1.3, 1.5, 1.7]},
+    )
+
+    def __init__(self, **values):
+        dist = values.get("distribution", "beckmann")
+        dist = dist.lower() if isinstance(dist, str) else dist
+        width = _TS_WIDTH.get(dist, "m")
+        beta = values.pop("beta", None)
+        if beta is not None:
+            if width in values:
+                raise ParameterError(
+                    f"{self.name}: give either 'beta' or {width!r} (the width of the "
+                    f"{dist} distribution), not both")
+            values[width] = _TS_FROM_BETA[dist](_check_beta(self.name, beta))
+        if values.get("c") is None and dist in _TS_DEFAULT_C:
+            values["c"] = _TS_DEFAULT_C[dist]
+        self.width_param = width
+        super().__init__(**values)
+
+    def _validate(self):
+        v = self._values
+        if v["distribution"] == "trowbridge-reitz" and v["c"] > 1.0:
+            raise ParameterError(
+                f"{self.name}: with distribution 'trowbridge-reitz' parameter 'c' (c3) must lie "
+                f"in (0, 1] (D3 peaks at the normal only then); got {v['c']:g}")
+
+    @classmethod
+    def width_from_beta(cls, beta: float) -> float:
+        return beckmann_m_from_beta(beta)
+
+    @classmethod
+    def describe(cls) -> dict:
+        d = super().describe()
+        d["beta"] = "n (phong), c (gaussian, trowbridge-reitz) or m (beckmann)"
+        return d
+
+    def _half_lobe(self):
+        v = self._values
+        dist = v["distribution"]
+        if dist == "phong":
+            return "phong", float(v["n"])
+        if dist == "gaussian":
+            return "beckmann", 1.0 / float(v["c"])  # exp(−c²α²) ≈ exp(−tan²α/m²), m = 1/c
+        if dist == "trowbridge-reitz":
+            return "ggx", float(v["c"])  # D₃ ∝ GGX with α = c₃
+        return "beckmann", float(v["m"])
+
+    def lobes(self):
+        v = self._values
+        dist = v["distribution"]
+        if dist == "phong":
+            beta = beta_from_exponent(v["n"]) if v["n"] > 0 else math.pi / 2
+        elif dist == "gaussian":
+            beta = min(math.sqrt(math.log(2.0)) / v["c"], math.pi / 2)
+        elif dist == "trowbridge-reitz":
+            beta = beta_from_trowbridge_reitz_c(v["c"]) if v["c"] < 2.0**-0.25 else math.pi / 2
+        else:
+            beta = beta_from_beckmann_m(v["m"])
+        return [Lobe("half", float(beta))]
+
+
+_TS_FROM_BETA = {
+    "phong": exponent_from_beta,
+    "gaussian": gaussian_c_from_beta,
+    "trowbridge-reitz": trowbridge_reitz_c_from_beta,
+    "beckmann": beckmann_m_from_beta,
+}
+
+
+# =========================================================================== Cook-Torrance
+CT_PARAMS = (
+    M_SLOPE,
+    ETA_DIELECTRIC,
+    Param("rho_s", 1.0, 0.0, 1.0, "", "specular scale", kind="colour"),
+)
+CT_M, CT_ETA, CT_RHO_S = packed_indices(CT_PARAMS, "m", "eta", "rho_s")
+
+
+@numba.njit(cache=True)
+def _cook_torrance_grazing(iz, oz, sx, sy, sz, m, eta, rho_s):
+    """:func:`_cook_torrance` when s = wi + wo is shorter than SMALL_LENGTH (not inlined).
+
+    The squares of the components of s underflow there (cos²δ = s_z²/|s|² would be 0/0,
+    which the kernel returned as 0). Written with s/q, q the largest component: cos δ and
+    tan δ are scale-invariant, |s| = q|s/q| and 4 s_z (N·V)/|s|² = 4 (s_z/q)(N·V)/(q|s/q|²).
+    """
+    q = max(abs(sx), abs(sy), sz)  # ≥ sz > 0 above the horizon
+    a, b, c = sx / q, sy / q, sz / q
+    l2 = a * a + b * b + c * c  # in [1, 3]: no underflow
+    root = math.sqrt(l2)
+    c2 = c * c / l2  # cos²δ
+    e = -(1.0 - c2) / (c2 * m * m)
+    if not e >= -700.0:
+        return 0.0  # D < 1e-290 (see beckmann_lobe)
+    d = math.exp(e) / (4.0 * math.pi * m * m * c2 * c2)
+    g = min(1.0, 4.0 * c * min(iz, oz) / (l2 * q))  # ≤ 4c²/l2 since min(iz, oz) ≤ s_z = c q
+    f = 1.0 if eta == 0.0 else _fresnel_dielectric(0.5 * q * root, eta)
+    return rho_s * f * d * g / max(iz * oz, DENOM_FLOOR)  # floor: see DENOM_FLOOR
+
+
+@numba.njit(cache=True, error_model="numpy", fastmath=_FAST)
+def _cook_torrance(ix, iy, iz, ox, oy, oz, p):
+    if below_horizon(iz, oz):
+        return 0.0
+    m, eta, rho_s = p[CT_M], p[CT_ETA], p[CT_RHO_S]
+    # Written with s = wi + wo (five divisions, one square root): cos²δ = s_z²/|s|²,
+    # tan²δ = |s_xy|²/s_z²,
+    # L·H = V·H = |s|/2 (unit vectors) and, in eq. (10), 2(N·H)(N·V)/(V·H) = 4 s_z (N·V)/|s|².
+    sx = ix + ox
+    sy = iy + oy
+    sz = iz + oz  # > 0 above the horizon
+    if sz < SMALL_LENGTH:  # rare: both directions within 1e-140 of the horizon
+        return _cook_torrance_grazing(iz, oz, sx, sy, sz, m, eta, rho_s)
+    sxy2 = sx * sx + sy * sy
+    sz2 = sz * sz
+    l2 = sxy2 + sz2
+    length = math.sqrt(l2)  # |s| ≥ s_z > 0
+    hz = sz / length
+    c2 = hz * hz  # cos²δ
+    # −tan²δ/m² rounded exactly as beckmann_lobe (with half()'s N·H): the rounding of the
+    # exponent is amplified up to 700× by e^x, and torrance-sparrow's D₄ must agree to 1e-13
+    e = -(1.0 - c2) / (c2 * m * m)
+    if not e >= -700.0:
+        return 0.0  # D < 1e-290 (see beckmann_lobe); NaN (0/0 at the horizon): see _beckmann_dgg
+    d = math.exp(e) / (4.0 * math.pi * m * m * c2 * c2)  # e^{−tan²δ/m²}/(4π m² cos⁴δ)
+    g = min(1.0, 4.0 * sz * min(iz, oz) / l2)  # V-groove G, eq. (10) (g_vgroove)
+    f = 1.0 if eta == 0.0 else _fresnel_dielectric(0.5 * length, eta)  # no eta: F = 1
+    return rho_s * f * d * g / max(iz * oz, DENOM_FLOOR)  # floor: see DENOM_FLOOR
+
+
+@register
+class CookTorrance(_HalfVectorSampling, BRDF):
+    """Cook–Torrance model as written by Neumann et al., eqs. (9)–(10).
+
+    f_r = ρ_s F · e^{−tan²δ/m²}/(4π m² cos⁴δ) · G/((N·L)(N·V)), δ the angle
+    between N and H, G the V-groove factor of eq. (10), F the dielectric
+    Fresnel of L·H (F = 1 without ``eta``, as in Neumann Fig. 1).
+
+    =====  =======  ===========  ==============================================
+    name   default  bounds       meaning
+    =====  =======  ===========  ==============================================
+    m      0.1      [1e-4, 100]  RMS slope; or give ``beta`` (Lewis's D₄ m(β))
+    eta    None     (0, 100]     index of refraction (per channel); None: F = 1
+    rho_s  1        [0, 1]       scale (per channel)
+    =====  =======  ===========  ==============================================
+
+    This is exactly Walter's microfacet BRDF D G/(4 (N·L)(N·V)) with the
+    normalised Beckmann D = e^{−tan²δ/m²}/(π m² cos⁴δ) and the V-groove G,
+    and equal to ``torrance-sparrow`` with D₄. Reciprocal. Its albedo
+    diverges as θ_i → 90° (Neumann §2.1, eq. 15): near the mirror
+    configuration G = 1 and f ~ 1/((N·L)(N·V)). Sampled by the Beckmann
+    distribution of normals (exact pdf).
+    """
+
+    name = "cook-torrance"
+    aliases = ("cook", "cooktorrance")
+    summary = "Cook-Torrance: Beckmann D, V-groove G, Fresnel / (4 N.L N.V)"
+    params = CT_PARAMS
+    citation = "Neumann et al. 1999 eqs. (9)-(10) (Cook & Torrance 1982)"
+    albedo_kinks = frozenset({"vgroove"})  # G of eq. (10)
+    reciprocal = True
+    has_sampler = True
+    width_param = "m"
+    kernel = _cook_torrance
+    examples = (
+        {},
+        {"m": 0.01},
+        {"m": 0.5, "eta": [1.3, 1.5, 1.7], "rho_s": [0.9, 0.8, 0.7]},
+    )
+
+    @classmethod
+    def width_from_beta(cls, beta: float) -> float:
+        return beckmann_m_from_beta(beta)
+
+    def _half_lobe(self):
+        return "beckmann", float(self._values["m"])
+
+    def lobes(self):
+        return [Lobe("half", float(beta_from_beckmann_m(self._values["m"])))]
