@@ -3,8 +3,7 @@
 - A module imports only from its own layer and the layers below (imports inside
   functions count too).
 - No brdfkit module is imported inside ``try/except ImportError`` (self-guarding).
-- No source file over 600 lines (issue 18: modules by concept); the files still being
-  split by other work are listed in OVER_LIMIT until they are.
+- No source file over 600 lines (issue 18: modules by concept), without exceptions.
 - No engine probes a model with getattr/hasattr for a protocol hook.
 """
 
@@ -30,15 +29,11 @@ LAYER = {
     "figures": 4, "cli": 4, "report": 4, "explorer": 4, "__main__": 4,
 }
 MAX_LINES = 600
-#: Files over MAX_LINES whose split is owned by another part of issue 18 (helper "loops":
-#: one module per microfacet family). Each keeps the former cap of 850 until its split is
-#: merged; the coordinator empties this after merging it (an entry under the cap fails, so
-#: a merged split must also leave this list).
-OVER_LIMIT: dict[str, int] = {}
 #: hooks of the model protocol that must be read as declared attributes, never probed
 HOOKS = {"isotropic", "specular_albedo", "albedo_kinks", "albedo_kinks_nv", "albedo_kink_mus",
          "has_delta", "has_sampler", "lobes", "sharpest_lobe", "kernel", "packed", "n_channels",
-         "reciprocal", "sample", "pdf", "to_dict", "formulas", "fit_gauge"}
+         "reciprocal", "sample", "pdf", "to_dict", "formulas", "fit_gauge", "fit_base",
+         "fit_bound_starts"}
 
 
 def _modules():
@@ -103,16 +98,8 @@ def test_no_self_guarding_imports(path):
 @pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(SRC)))
 def test_source_files_are_not_too_long(path):
     n = len(path.read_text().splitlines())
-    rel = path.relative_to(SRC).as_posix()
-    cap = OVER_LIMIT.get(rel, MAX_LINES)
-    assert n <= cap, f"{path} has {n} lines (> {cap}): split it (one module per concept)"
-
-
-@pytest.mark.parametrize("rel", sorted(OVER_LIMIT))
-def test_over_limit_list_is_current(rel):
-    # an entry must still be needed: once its file is split below the cap, remove it
-    n = len((SRC / rel).read_text().splitlines())
-    assert n > MAX_LINES, f"{rel} has {n} lines (<= {MAX_LINES}): remove it from OVER_LIMIT"
+    assert n <= MAX_LINES, (f"{path} has {n} lines (> {MAX_LINES}): split it (one module "
+                            "per concept)")
 
 
 @pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(SRC)))
