@@ -71,17 +71,28 @@ from brdfkit.data.catalog import (
 )
 from brdfkit.errors import BrdfkitError, ParameterError, UnknownModelError
 from brdfkit.models import BRDF, resolve
-from brdfkit.pumping import G_CHOICES, MAX_TIMES, pump
 
 __all__ = ["ModelSpec", "Operator", "model", "model_params", "canonical_name", "parse_items",
            "times_problem", "is_material_spec", "KINDS", "SpecKind", "OPERATORS",
-           "OperatorKind", "SPEC_FORMS", "PUMP_CHOICES", "MAX_TIMES", "TIMES_REASON"]
+           "OperatorKind", "SPEC_FORMS", "PUMP_CHOICES", "MAX_TIMES",  # noqa: F822 (lazy)
+           "TIMES_REASON"]
 
 #: How a material spec is written (for error messages and help texts).
 SPEC_FORMS = ("merl:NAME[@nbrdf|@npf|@abc|@sgd], rgl:NAME, nielsen:NAME or a path to a "
               "MERL .binary file ('brdfkit materials' lists the built-in ones)")
-#: The built-in g of the pump operator (:data:`brdfkit.pumping.G_CHOICES`).
-PUMP_CHOICES = tuple(G_CHOICES)
+# brdfkit.pumping is imported on first use, not with the package (`import brdfkit`, every
+# command's start, does not pay ~7 ms for it); so are PUMP_CHOICES (its G_CHOICES) and MAX_TIMES.
+def _pumping():
+    import brdfkit.pumping
+    return brdfkit.pumping
+
+
+def __getattr__(name: str):
+    if name in ("PUMP_CHOICES", "MAX_TIMES"):
+        return tuple(_pumping().G_CHOICES) if name == "PUMP_CHOICES" else _pumping().MAX_TIMES
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 #: Why the number of pumpings is bounded (:data:`MAX_TIMES`), for messages and help.
 TIMES_REASON = ("each pumping tabulates the previous stage's albedo, so the cost grows with "
                 "the number of stages: times=8 takes about a minute")
@@ -259,11 +270,13 @@ def parse_items(name, items: Iterable[str] | Mapping, *, option: str = "-p") -> 
 def times_problem(times) -> str | None:
     """Why *times* is not a valid number of pumpings (without the option name), or None."""
     try:
-        ok = not isinstance(times, bool) and int(times) == times and 1 <= times <= MAX_TIMES
+        top = _pumping().MAX_TIMES
+        ok = not isinstance(times, bool) and int(times) == times and 1 <= times <= top
     except (TypeError, ValueError):  # not a number at all (e.g. a string through the API)
         ok = False
     if not ok:
-        return f"must be an integer from 1 to {MAX_TIMES}; got {times} ({TIMES_REASON})"
+        return (f"must be an integer from 1 to {_pumping().MAX_TIMES}; got {times} "
+                f"({TIMES_REASON})")
     return None
 
 
@@ -304,7 +317,7 @@ def _pump_check(args: Mapping) -> dict:
     g = args.get("g", "max")
     if g == "custom":
         raise ParameterError("from_dict: a custom g cannot be rebuilt from a dict")
-    if g not in G_CHOICES:
+    if g not in _pumping().G_CHOICES:
         raise ParameterError(f"pump must be 'max', 'controlled' or none; got {g!r}")
     times = args.get("times", 1)
     problem = times_problem(times)
@@ -320,7 +333,7 @@ def _pump_value(stages: list) -> object:
 #: The operators a spec applies, by key. Energy compensation, next, is one more entry.
 OPERATORS: dict[str, OperatorKind] = {
     "pump": OperatorKind("pump", _pump_stages, _pump_check,
-                         lambda m, a: pump(m, a["g"], times=a["times"]), _pump_value,
+                         lambda m, a: _pumping().pump(m, a["g"], times=a["times"]), _pump_value,
                          flat=("times",)),
 }
 #: The dict form's keys: the target, its parameters, each operator and its flat siblings.
@@ -480,26 +493,13 @@ class ModelSpec:
     @classmethod
     def parse(cls, target, params: Iterable[str] | Mapping = (), pump: str | None = None,
               times: int | None = None, *, option: str = "-p") -> ModelSpec:
-        """The spec of the command line's ``MODEL -p NAME=VALUE … --pump G --times K``.
-
-        Parameters
-        ----------
-        target : str
-            Registered name or alias, or a material spec (:data:`KINDS`).
-        params : iterable of ``NAME=VALUE`` str, or mapping
-            See :func:`parse_items` (``beta`` in degrees there).
-        pump : {None, "max", "controlled"}
-            Pump the model (:func:`brdfkit.pumping.pump`) with this g.
-        times : int, optional
-            How many times to pump, 1 … :data:`MAX_TIMES` (default 1); only with *pump*.
-        option : str
-            The option the items came from, named in the error for a malformed one.
-
-        Raises
-        ------
-        BrdfkitError
-            Unknown model, bad parameter, *times* out of range, or *times*
-            given without *pump* (it would be silently ignored).
+        """The spec of the command line's ``MODEL -p NAME=VALUE … --pump G --times K``:
+        *target* a name of :data:`KINDS`; *params* ``NAME=VALUE`` words or a mapping
+        (:func:`parse_items`: ``beta`` in degrees); *pump* None, ``"max"`` or
+        ``"controlled"`` (:func:`brdfkit.pumping.pump`) applied *times* times (1 …
+        :data:`MAX_TIMES`, default 1; only with *pump*); *option* is named in the error for
+        a malformed item. Raises :class:`BrdfkitError` for an unknown model, a bad
+        parameter, *times* out of range or *times* without *pump* (it would be ignored).
         """
         values = parse_items(target, params, option=option)
         if pump is None and times is not None:
@@ -511,8 +511,9 @@ class ModelSpec:
             problem = times_problem(times)
             if problem is not None:
                 raise BrdfkitError(f"--times {problem}")
-            if pump not in G_CHOICES:
-                raise BrdfkitError(f"--pump must be one of {', '.join(G_CHOICES)}; got {pump!r}")
+            choices = _pumping().G_CHOICES
+            if pump not in choices:
+                raise BrdfkitError(f"--pump must be one of {', '.join(choices)}; got {pump!r}")
             ops = (Operator("pump", (("g", pump), ("times", int(times)))),)
         return cls(target, values, ops)
 
