@@ -47,6 +47,7 @@ from brdfkit.models._lobes import (
     lobe_hint,
     lobe_pow,
 )
+from brdfkit.models._params import packed_indices
 from brdfkit.models._registry import register
 from brdfkit.models.sampling import (
     COSINE,
@@ -61,11 +62,15 @@ __all__ = ["PhongBlinnReciprocal", "NHPowerSeries", "ModifiedBlinnPhong"]
 
 
 # --------------------------------------------------------------------------- Lewis eq. (24)
+RECIPROCAL_PARAMS = (K_D, K_S, N_EXP)
+P_K_D, P_K_S, P_K_N = packed_indices(RECIPROCAL_PARAMS, "k_d", "k_s", "n")
+
+
 @numba.njit(cache=True)
 def _phong_blinn_reciprocal(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
-    return p[0] + p[1] * lobe_pow(n_dot_h(ix, iy, iz, ox, oy, oz), p[2])
+    return p[P_K_D] + p[P_K_S] * lobe_pow(n_dot_h(ix, iy, iz, ox, oy, oz), p[P_K_N])
 
 
 @register
@@ -91,7 +96,7 @@ class PhongBlinnReciprocal(KdKsBlinnBRDF):
     name = "phong-blinn-reciprocal"
     aliases = ("reciprocal-phong-blinn", "reciprocal-blinn", "blinn-reciprocal")
     summary = "Lewis's reciprocal Phong-Blinn shader, k_d + k_s (N.H)^n"
-    params = (K_D, K_S, N_EXP)
+    params = RECIPROCAL_PARAMS
     citation = "Lewis 1993 eq. (24); Neumann et al. 1999 eq. (6) (reciprocal Blinn)"
     reciprocal = True
     width_param = "n"
@@ -176,11 +181,15 @@ class NHPowerSeries(CosineLobeBRDF):
 
 
 # --------------------------------------------------------------------------- Nielsen eq. (2)
+MODIFIED_BLINN_PARAMS = (RHO_D, RHO_S, N_EXP)
+P_RHO_D, P_RHO_S, P_N = packed_indices(MODIFIED_BLINN_PARAMS, "rho_d", "rho_s", "n")
+
+
 @numba.njit(cache=True)
 def _modified_blinn_phong(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
-    rho_d, rho_s, n = p[0], p[1], p[2]
+    rho_d, rho_s, n = p[P_RHO_D], p[P_RHO_S], p[P_N]
     nh = n_dot_h(ix, iy, iz, ox, oy, oz)
     return rho_d * INV_PI + rho_s * (n + 8.0) * (1.0 / (8.0 * math.pi)) * lobe_pow(nh, n)
 
@@ -218,7 +227,7 @@ class ModifiedBlinnPhong(CosineLobeBRDF):
     name = "modified-blinn-phong"
     aliases = ("blinn-phong-modified", "nielsen-blinn-phong")
     summary = "normalised reciprocal Blinn-Phong, rho_d/pi + rho_s (n+8)/8pi (N.H)^n"
-    params = (RHO_D, RHO_S, N_EXP)
+    params = MODIFIED_BLINN_PARAMS
     citation = "Nielsen et al. eq. (2); Akenine-Möller et al. 2008"
     reciprocal = True
     width_param = "n"

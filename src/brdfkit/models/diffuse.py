@@ -33,16 +33,19 @@ from brdfkit.halfangle import (
     neumann_s_from_beta,
 )
 from brdfkit.models._base import BRDF, Lobe, Param
-from brdfkit.models._params import DIFFUSE_ALBEDO
+from brdfkit.models._params import DIFFUSE_ALBEDO, packed_indices
 from brdfkit.models._registry import register
 from brdfkit.models.sampling import CosPowerNormal, StrategySampled
+
+LAMBERT_PARAMS = (DIFFUSE_ALBEDO,)
+(P_RHO_D,) = packed_indices(LAMBERT_PARAMS, "rho_d")
 
 
 @numba.njit(cache=True)
 def _lambert(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
-    rho_d = p[0]
+    rho_d = p[P_RHO_D]
     return rho_d * INV_PI
 
 
@@ -62,7 +65,7 @@ class Lambert(BRDF):
     name = "lambert"
     aliases = ("diffuse", "lambertian")
     summary = "Lambertian diffuse: rho_d/pi"
-    params = (DIFFUSE_ALBEDO,)
+    params = LAMBERT_PARAMS
     citation = "Lambert 1760; Lewis 1993 eq. (8) with k_s = 0 (k_d = rho_d/pi)"
     reciprocal = True
     has_sampler = True
@@ -70,11 +73,18 @@ class Lambert(BRDF):
 
 
 # --------------------------------------------------------------------------- Neumann-Neumann
+NEUMANN_NEUMANN_PARAMS = (
+    Param("b_N", 0.25, 0.0, 10.0, "1/sr", "value at S = V = N", kind="colour"),
+    Param("s", 0.5, 0.0, 1e7, "", "optical thickness of the lacquer; larger = narrower lobe"),
+)
+P_B_N, P_S = packed_indices(NEUMANN_NEUMANN_PARAMS, "b_N", "s")
+
+
 @numba.njit(cache=True)
 def _neumann_neumann(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
-    b_n, s = p[0], p[1]
+    b_n, s = p[P_B_N], p[P_S]
     if s == 0.0:
         return b_n  # the lacquer is clear: a Lambertian b_N (avoids 0 * inf below)
     # 1/iz overflows to inf only for subnormal iz; exp(-inf) = 0 is then the right limit.
@@ -118,10 +128,7 @@ class NeumannNeumann(StrategySampled, BRDF):
     name = "neumann-neumann"
     aliases = ("lacquer", "neumann-lacquer")
     summary = "Neumann-Neumann lacquer: b_N exp{-s(1/N.S + 1/N.V - 2)}"
-    params = (
-        Param("b_N", 0.25, 0.0, 10.0, "1/sr", "value at S = V = N", kind="colour"),
-        Param("s", 0.5, 0.0, 1e7, "", "optical thickness of the lacquer; larger = narrower lobe"),
-    )
+    params = NEUMANN_NEUMANN_PARAMS
     citation = "Lewis 1993 §3.3 (after Neumann & Neumann 1989)"
     reciprocal = True
     has_sampler = True
@@ -163,11 +170,28 @@ def _minnaert_core(iz, oz, k):
     return max(iz, COS_FLOOR) ** e * max(oz, COS_FLOOR) ** e  # floor: see COS_FLOOR
 
 
+K_MINNAERT = Param("k", 2.0, 0.0, 1e7, "",
+                   "Minnaert exponent: 1 is Lambertian, > 1 peaks at the normal, < 1 brightens "
+                   "toward the limb (the Moon: ~0.5-1)", lower_open=True)
+
+
+MINNAERT_PARAMS = (
+    Param("b_M", 0.2, 0.0, 10.0, "1/sr", "scale (value at S = V = N)", kind="colour"),
+    K_MINNAERT,
+)
+P_B_M, P_K = packed_indices(MINNAERT_PARAMS, "b_M", "k")
+MINNAERT_EC_PARAMS = (
+    Param("k_rho", 0.8, 0.0, 1.0, "", "albedo at normal incidence", kind="colour"),
+    K_MINNAERT,
+)
+P_K_RHO, P_EC_K = packed_indices(MINNAERT_EC_PARAMS, "k_rho", "k")
+
+
 @numba.njit(cache=True)
 def _minnaert(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
-    b_m, k = p[0], p[1]
+    b_m, k = p[P_B_M], p[P_K]
     return b_m * _minnaert_core(iz, oz, k)
 
 
@@ -175,17 +199,12 @@ def _minnaert(ix, iy, iz, ox, oy, oz, p):
 def _minnaert_ec(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
-    k_rho, k = p[0], p[1]
+    k_rho, k = p[P_K_RHO], p[P_EC_K]
     return k_rho * (k + 1.0) * INV_TWO_PI * _minnaert_core(iz, oz, k)
 
 
 def _minnaert_lobes(k: float) -> list:
     return [Lobe("normal", beta_from_minnaert_k(k) if k > 1.0 else math.pi / 2)]
-
-
-K_MINNAERT = Param("k", 2.0, 0.0, 1e7, "",
-                   "Minnaert exponent: 1 is Lambertian, > 1 peaks at the normal, < 1 brightens "
-                   "toward the limb (the Moon: ~0.5-1)", lower_open=True)
 
 
 @register
@@ -216,10 +235,7 @@ class Minnaert(StrategySampled, BRDF):
     name = "minnaert"
     aliases = ("minnaert-lewis",)
     summary = "Minnaert: b_M ((N.S)(N.V))^(k-1)"
-    params = (
-        Param("b_M", 0.2, 0.0, 10.0, "1/sr", "scale (value at S = V = N)", kind="colour"),
-        K_MINNAERT,
-    )
+    params = MINNAERT_PARAMS
     citation = "Lewis 1993 §3.4 (after Minnaert 1941)"
     reciprocal = True
     has_sampler = True
@@ -272,10 +288,7 @@ class MinnaertEnergyConserving(StrategySampled, BRDF):
     name = "minnaert-energy-conserving"
     aliases = ("minnaert-ec", "minnaert-normalised", "minnaert-normalized")
     summary = "energy-normalised Minnaert: k_rho (k+1)/2pi ((N.S)(N.V))^(k-1)"
-    params = (
-        Param("k_rho", 0.8, 0.0, 1.0, "", "albedo at normal incidence", kind="colour"),
-        K_MINNAERT,
-    )
+    params = MINNAERT_EC_PARAMS
     citation = "Lewis 1993 §4.3"
     reciprocal = True
     has_sampler = True

@@ -60,11 +60,21 @@ __all__ = ["NeumannPhong", "Nielsen"]
 
 
 # --------------------------------------------------------------------------- Neumann eq. (22)
+NEUMANN_PHONG_PARAMS = (
+    Param("c_n", None, 0.0, 1e7, "1/sr",
+          "scale; none: (n+2)/2pi, the paper's bound (not sufficient, see docs)",
+          kind="colour", optional=True),
+    N_EXP,
+)
+# one slot each, in declared order (NeumannPhong._pack_channel writes c_n's value in use)
+P_C_N, P_N = packed_indices(NEUMANN_PHONG_PARAMS, "c_n", "n")
+
+
 @numba.njit(cache=True)
 def _neumann_phong(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
-    c_n, n = p[0], p[1]
+    c_n, n = p[P_C_N], p[P_N]
     # max(N·L, N·V) > 0 above the horizon but can be subnormal (both directions within
     # 1e-300 of the horizon), where c_n/max overflows; floored at COS_DIVISOR_FLOOR (see there)
     return c_n * lobe_pow(r_dot_v(ix, iy, iz, ox, oy, oz), n) / max(iz, oz, COS_DIVISOR_FLOOR)
@@ -105,12 +115,7 @@ class NeumannPhong(CosineLobeBRDF):
     name = "neumann-phong"
     aliases = ("neumann-22", "pumped-phong-limit")
     summary = "Neumann et al. eq. (22): c_n (R.V)^n / max(N.L, N.V)"
-    params = (
-        Param("c_n", None, 0.0, 1e7, "1/sr",
-              "scale; none: (n+2)/2pi, the paper's bound (not sufficient, see docs)",
-              kind="colour", optional=True),
-        N_EXP,
-    )
+    params = NEUMANN_PHONG_PARAMS
     citation = "Neumann et al. 1999 eq. (22)"
     albedo_kinks = frozenset({"nv=nl"})  # the max(N·L, N·V) denominator of eq. (22)
     reciprocal = True

@@ -73,6 +73,7 @@ from brdfkit.models._lobes import (
     lobe_hint,
     lobe_pow,
 )
+from brdfkit.models._params import packed_indices
 from brdfkit.models._registry import register
 from brdfkit.models.sampling import (
     COSINE,
@@ -139,11 +140,15 @@ def _hs_table(n: float, lobe: str) -> Lookup:
 
 
 # --------------------------------------------------------------------------- modified Phong
+MODIFIED_PHONG_PARAMS = (RHO_D, RHO_S, N_EXP)
+P_RHO_D, P_RHO_S, P_N = packed_indices(MODIFIED_PHONG_PARAMS, "rho_d", "rho_s", "n")
+
+
 @numba.njit(cache=True)
 def _modified_phong(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
-    rho_d, rho_s, n = p[0], p[1], p[2]
+    rho_d, rho_s, n = p[P_RHO_D], p[P_RHO_S], p[P_N]
     cos_r = r_dot_v(ix, iy, iz, ox, oy, oz)  # ω_r·ω_o
     return rho_d * INV_PI + rho_s * (n + 2.0) * INV_TWO_PI * lobe_pow(cos_r, n)
 
@@ -174,7 +179,7 @@ class ModifiedPhong(CosineLobeBRDF):
     name = "modified-phong"
     aliases = ("phong-modified", "nielsen-phong")
     summary = "normalised reciprocal Phong, rho_d/pi + rho_s (n+2)/2pi (R.V)^n"
-    params = (RHO_D, RHO_S, N_EXP)
+    params = MODIFIED_PHONG_PARAMS
     citation = "Nielsen et al. eq. (1); Neumann et al. 1999 eq. (6)"
     reciprocal = True
     has_sampler = True
@@ -198,11 +203,15 @@ class ModifiedPhong(CosineLobeBRDF):
 
 
 # --------------------------------------------------------------------------- Lewis: Phong, Blinn
+LEWIS_PARAMS = (K_D, K_S, N_EXP)
+P_K_D, P_K_S, P_K_N = packed_indices(LEWIS_PARAMS, "k_d", "k_s", "n")
+
+
 @numba.njit(cache=True)
 def _phong(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
-    k_d, k_s, n = p[0], p[1], p[2]
+    k_d, k_s, n = p[P_K_D], p[P_K_S], p[P_K_N]
     # Lewis eq. (8) with F_s^P of eq. (5). The true f diverges like 1/(N·L) and overflows
     # float64 for N·L < k_s/1.8e308; N·L is floored at COS_DIVISOR_FLOOR (see there)
     return k_d + k_s * lobe_pow(r_dot_v(ix, iy, iz, ox, oy, oz), n) / max(iz, COS_DIVISOR_FLOOR)
@@ -238,7 +247,7 @@ class Phong(CosineLobeBRDF):
     name = "phong"
     aliases = ("phong-original", "lewis-phong")
     summary = "original Phong shader as a BRDF, k_d + k_s (R.V)^n / (N.L) (not reciprocal)"
-    params = (K_D, K_S, N_EXP)
+    params = LEWIS_PARAMS
     citation = "Lewis 1993 eqs. (5) and (8)"
     reciprocal = False
     width_param = "n"
@@ -265,7 +274,7 @@ class Phong(CosineLobeBRDF):
 def _blinn(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
-    k_d, k_s, n = p[0], p[1], p[2]
+    k_d, k_s, n = p[P_K_D], p[P_K_S], p[P_K_N]
     # Lewis eq. (8) with F_s^B of eq. (6); N·L floored as in _phong (COS_DIVISOR_FLOOR)
     return k_d + k_s * lobe_pow(n_dot_h(ix, iy, iz, ox, oy, oz), n) / max(iz, COS_DIVISOR_FLOOR)
 
@@ -296,7 +305,7 @@ class Blinn(KdKsBlinnBRDF):
     name = "blinn"
     aliases = ("blinn-original", "lewis-blinn")
     summary = "Blinn shader as a BRDF, k_d + k_s (N.H)^n / (N.L) (not reciprocal)"
-    params = (K_D, K_S, N_EXP)
+    params = LEWIS_PARAMS
     citation = "Lewis 1993 eqs. (6) and (8)"
     reciprocal = False
     width_param = "n"
@@ -310,18 +319,32 @@ class Blinn(KdKsBlinnBRDF):
 
 # --------------------------------------------------------------------------- Lewis eq. (22)
 PHONG_LOBE, BLINN_LOBE = 0, 1
+ENERGY_CONSERVING_PARAMS = (
+    Param("k_rho", 0.8, 0.0, 1.0, "",
+          "directional-hemispherical reflectance: the albedo at every incident angle",
+          kind="colour"),
+    Param("k_sigma", 0.5, 0.0, 1.0, "", "fraction of the exitance reflected specularly",
+          kind="colour"),
+    N_EXP,
+    Param("lobe", "blinn", kind="choice", choices=("phong", "blinn"),
+          doc="specular function: phong (R.V)^n, Lewis eq. 5; blinn (N.H)^n, eq. 6"),
+)
+P_K_RHO, P_K_SIGMA, P_EC_N, P_LOBE = packed_indices(
+    ENERGY_CONSERVING_PARAMS, "k_rho", "k_sigma", "n", "lobe")
+#: where the H_s lookup starts: after the default row (PhongEnergyConserving._pack_channel)
+P_HS_TABLE = len(ENERGY_CONSERVING_PARAMS)
 
 
 @numba.njit(cache=True)
 def _phong_energy_conserving(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
-    k_rho, k_sigma, n = p[0], p[1], p[2]
-    if p[3] == PHONG_LOBE:
+    k_rho, k_sigma, n = p[P_K_RHO], p[P_K_SIGMA], p[P_EC_N]
+    if p[P_LOBE] == PHONG_LOBE:
         fs = lobe_pow(r_dot_v(ix, iy, iz, ox, oy, oz), n)
     else:
         fs = lobe_pow(n_dot_h(ix, iy, iz, ox, oy, oz), n)
-    hs = _lookup(p, 4, iz)  # H_s(S) > 0 at every θ_i, also at 90° (see _hs_table)
+    hs = _lookup(p, P_HS_TABLE, iz)  # H_s(S) > 0 at every θ_i, also at 90° (see _hs_table)
     return k_rho * ((1.0 - k_sigma) * INV_PI + k_sigma * fs / hs)
 
 
@@ -362,16 +385,7 @@ class PhongEnergyConserving(CosineLobeBRDF):
     name = "phong-energy-conserving"
     aliases = ("energy-conserving-phong", "lewis-energy-conserving")
     summary = "Lewis's energy-conserving Phong, k_rho[(1-k_sigma)/pi + k_sigma F_s/H_s(S)]"
-    params = (
-        Param("k_rho", 0.8, 0.0, 1.0, "",
-              "directional-hemispherical reflectance: the albedo at every incident angle",
-              kind="colour"),
-        Param("k_sigma", 0.5, 0.0, 1.0, "", "fraction of the exitance reflected specularly",
-              kind="colour"),
-        N_EXP,
-        Param("lobe", "blinn", kind="choice", choices=("phong", "blinn"),
-              doc="specular function: phong (R.V)^n, Lewis eq. 5; blinn (N.H)^n, eq. 6"),
-    )
+    params = ENERGY_CONSERVING_PARAMS
     citation = "Lewis 1993 eq. (22) with (5)/(6) and H_s of eq. (17)"
     reciprocal = False
     width_param = "n"
