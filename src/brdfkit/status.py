@@ -116,6 +116,12 @@ class StatusCodes:
     def message(self, code: int) -> str:
         return self[code].message
 
+    def describe(self, code: int, *details: str) -> str:
+        """A result's one-line ``message``: *code*'s message, then what this result
+        adds (its numbers, what did not converge), ``"; "``-joined; empty parts dropped."""
+        said = "; ".join(d for d in details if d)
+        return f"{self.message(code)}: {said}" if said else self.message(code)
+
     def __repr__(self) -> str:
         return f"StatusCodes({self.kind!r}, {[o.name for o in self]})"
 

@@ -340,8 +340,7 @@ def _status(fail: list[str], nonfinite: bool, unresolved: int) -> tuple[int, str
         fail = [f"{unresolved} cells unresolved"]
     else:
         code = _CODES.CONVERGED
-    text = _CODES.message(code)
-    return code, (f"{text}: {'; '.join(fail)}" if fail else text)
+    return code, _CODES.describe(code, *fail)
 
 
 def _pool(observed: np.ndarray, expected: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -64,8 +64,7 @@ class HemisphericalAlbedo:
     @property
     def message(self) -> str:
         """The status table's message, with the engine's when it did not converge."""
-        text = _CODES.message(self.status)
-        return f"{text}: {self.detail}" if self.detail else text
+        return _CODES.describe(self.status, self.detail)
 
     def to_dict(self) -> dict:
         """JSON-ready: value and error (lists when coloured), n, status, success, message."""

@@ -109,8 +109,7 @@ class Verdict:
 
     @property
     def message(self) -> str:
-        text = _CODES.message(self.status)
-        return f"{text} ({self.detail})" if self.detail else text
+        return _CODES.describe(self.status, self.detail)
 
     def to_dict(self) -> dict:
         """JSON-ready dict with the keys of ``brdfkit check --json``."""

@@ -173,7 +173,7 @@ class AmbientTable:
 
     @property
     def message(self) -> str:
-        return f"{STATUS['render'].message(self.status)}: {self.detail}"
+        return STATUS["render"].describe(self.status, self.detail)
 
     def __post_init__(self):
         object.__setattr__(self, "_interp", _spline(self.theta, self.rho))

@@ -132,12 +132,9 @@ class SphereRender:
     def message(self) -> str:
         """The status's message, then the ambient term's statement and, for Monte Carlo,
         the largest standard error."""
-        parts = [self.ambient_message] if self.ambient_message else []
-        if self.mc_error is not None:
-            parts.append(f"standard error up to {self.mc_error_max:.3g} per pixel "
-                         f"({self.passes} passes)")
-        text = _CODES.message(self.status)
-        return f"{text}: {'; '.join(parts)}" if parts else text
+        mc = ("" if self.mc_error is None else
+              f"standard error up to {self.mc_error_max:.3g} per pixel ({self.passes} passes)")
+        return _CODES.describe(self.status, self.ambient_message, mc)
 
     @property
     def mc_error_max(self) -> float | None:
