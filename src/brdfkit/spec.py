@@ -47,7 +47,7 @@ Public objects
 - :func:`model` — build a model or a material from its name (``brdfkit.model``).
 - :func:`model_params` — the parameter declarations a name accepts.
 - :func:`canonical_name` — a name's canonical name.
-- :func:`parse_items` — ``NAME=VALUE`` words → parameter values.
+- :func:`parse_items`, :func:`property_value` — ``NAME=VALUE`` words, a flat property → values.
 - :func:`times_problem` — why a number of pumpings is invalid, or None.
 - :func:`is_material_spec` — whether a name is a material spec.
 - :data:`KINDS`, :class:`SpecKind`; :data:`OPERATORS`, :class:`OperatorKind`.
@@ -73,7 +73,7 @@ from brdfkit.errors import BrdfkitError, ParameterError, UnknownModelError
 from brdfkit.models import BRDF, resolve
 
 __all__ = ["ModelSpec", "Operator", "model", "model_params", "canonical_name", "parse_items",
-           "times_problem", "is_material_spec", "KINDS", "SpecKind", "OPERATORS",
+           "property_value", "times_problem", "is_material_spec", "KINDS", "SpecKind", "OPERATORS",
            "OperatorKind", "SPEC_FORMS", "PUMP_CHOICES", "MAX_TIMES",  # noqa: F822 (lazy)
            "TIMES_REASON"]
 
@@ -265,6 +265,17 @@ def parse_items(name, items: Iterable[str] | Mapping, *, option: str = "-p") -> 
         else:
             out[key] = _parse_number(text, key, label, bounds)
     return out
+
+
+def property_value(key: str, value, *, where: str):
+    """A flat property's value: a string with commas as a list of numbers, else as given."""
+    if not (isinstance(value, str) and "," in value):
+        return value
+    try:
+        return [float(x) for x in value.split(",")]
+    except ValueError:
+        raise ParameterError(f"{where}: property {key!r} must be a number, a word or a "
+                             f"comma-separated list of numbers; got {value!r}") from None
 
 
 def times_problem(times) -> str | None:
@@ -519,12 +530,9 @@ class ModelSpec:
 
     @classmethod
     def from_properties(cls, props: Mapping, *, where: str = "brdfkit plugin") -> ModelSpec:
-        """The spec of a flat property list: ``{"model": NAME, PARAM: VALUE, …,
-        "pump": G, "times": K}`` (the Mitsuba plugin's scene-dict properties).
-
-        Values are in API units; a string with commas is a list of numbers
-        (``"eta": "0.2, 0.9, 1.1"``). *where* prefixes the errors.
-        """
+        """The spec of a flat property list (the Mitsuba plugin's scene-dict properties):
+        ``{"model": NAME, PARAM: VALUE, …, "pump": G, "times": K}``, values in API units
+        (:func:`property_value`: ``"eta": "0.2, 0.9, 1.1"``); *where* prefixes the errors."""
         if "model" not in props:
             raise ParameterError(
                 f'{where}: property "model" is required (a model name such as '
@@ -534,14 +542,7 @@ class ModelSpec:
             if key in _DICT_KEYS:
                 spec.setdefault(key, value)
                 continue
-            if isinstance(value, str) and "," in value:
-                try:
-                    value = [float(x) for x in value.split(",")]
-                except ValueError:
-                    raise ParameterError(
-                        f"{where}: property {key!r} must be a number, a word or a "
-                        f"comma-separated list of numbers; got {value!r}") from None
-            spec["params"][key] = value
+            spec["params"][key] = property_value(key, value, where=where)
         return cls.from_dict(spec)
 
     # --------------------------------------------------------------- dicts

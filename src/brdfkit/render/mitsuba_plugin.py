@@ -27,7 +27,7 @@ from brdfkit._cache import bounded_cache
 from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
 from brdfkit.render.mitsuba_variants import VARIANTS, import_mitsuba
-from brdfkit.spec import ModelSpec
+from brdfkit.spec import ModelSpec, property_value
 
 __all__ = ["register_plugin"]
 
@@ -52,21 +52,11 @@ def _model_from_props(props) -> tuple[BRDF, list | None]:
                 f'pump_g={flat.get("pump_g")!r}, times={flat.get("times")!r}')
         g, n = flat.pop("pump_g", "max"), int(old or 0)
         flat.update(pump=g if n else None, times=n if n else None)
-    wavelengths = (np.atleast_1d(np.asarray(_list(props["wavelengths"]), dtype=np.float64))
-                   if "wavelengths" in props.keys() else None)
+    wavelengths = None
+    if "wavelengths" in props.keys():
+        given = property_value("wavelengths", props["wavelengths"], where="brdfkit plugin")
+        wavelengths = np.atleast_1d(np.asarray(given, dtype=np.float64))
     return ModelSpec.from_properties(flat).build(), wavelengths
-
-
-def _list(value):
-    """A property value "a, b, c" (a string) as floats; anything else as given."""
-    if isinstance(value, str) and "," in value:
-        try:
-            return [float(x) for x in value.split(",")]
-        except ValueError:
-            raise ParameterError(
-                f"brdfkit plugin: property 'wavelengths' must be a number or a comma-separated "
-                f"list of numbers; got {value!r}") from None
-    return value
 
 
 def register_plugin(variant: str, make_bsdf: Callable) -> None:
