@@ -99,8 +99,8 @@ from brdfkit.models._drivers import generic_loop, loop_driver
 from brdfkit.status import STATUS
 
 __all__ = ["AlbedoResult", "albedo", "evaluate_pairs", "check_theta", "check_phi", "incident",
-           "lobe_frame",
-           "STATUS_MESSAGES", "CONVERGED", "MAX_LEVEL_REACHED", "NODE_CAP", "NONFINITE"]
+           "lobe_frame", "STATUS_MESSAGES", "CONVERGED", "MAX_LEVEL_REACHED", "NODE_CAP",
+           "NONFINITE"]
 
 
 
