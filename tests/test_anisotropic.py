@@ -418,3 +418,32 @@ def test_cli_check_phi(cli_model):
 @pytest.mark.parametrize("value", ["nan", "inf", "-inf", "east", "", "1e999"])
 def test_cli_bad_phi_is_one_error_line(command, value):
     assert_one_line_error(run(command, "lambert", "--phi", value), "--phi", "finite")
+
+
+def test_figure_slices_at_phi(model):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from brdfkit.figures.models import _THETA_A_DEG, model_slices
+
+    fig = model_slices(model, theta_i_deg=(60.0,), n_points=91, phi_deg=90.0)
+    try:
+        assert "90°" in fig._suptitle.get_text()
+        ax_s, ax_a = fig.axes[:2]
+        want = np.asarray(albedo(model, np.radians(_THETA_A_DEG), phi=math.pi / 2,
+                                 tol=1e-4).albedo)
+        np.testing.assert_allclose(ax_a.get_lines()[0].get_ydata(), want, rtol=0, atol=1e-12)
+        # the slice lies in the plane at azimuth 90°: the mirror direction of L at
+        # (60°, 90° + 180°) is V at (60°, 90°), where the plotted f is Ward's value there
+        x, y = ax_s.get_lines()[0].get_data()
+        k = int(np.argmin(np.abs(x - 60.0)))
+        t, to = math.radians(60.0), math.radians(x[k])
+        wi = np.array([0.0, -math.sin(t), math.cos(t)])
+        wo = np.array([0.0, math.sin(to), math.cos(to)])
+        assert y[k] == pytest.approx(float(model.eval(wi, wo)), rel=1e-12)
+    finally:
+        plt.close(fig)
+    with pytest.raises(ParameterError, match="phi_deg"):
+        model_slices(model, phi_deg=float("nan"))
