@@ -263,7 +263,9 @@ def _si(view):
 
 
 MODELS = {"ggx": lambda: user_ggx_model(0.2), "rgb": lambda: user_rgb_model((0.7, 0.35, 0.1), 0.3),
-          "index-grey": lambda: user_rgb_model(0.4, 0.3)}
+          "index-grey": lambda: user_rgb_model(0.4, 0.3),
+          # a diffuse lobe: the cosine alone (w_c = 1, the GGX lanes discarded but finite)
+          "cosine-proxy": lambda: user_ggx_model(0.3, lobes=[Lobe("diffuse", math.pi / 2)])}
 
 
 @pytest.mark.parametrize("which", list(MODELS))

@@ -46,7 +46,7 @@ by π f/w_c wherever the GGX part misses (a diffuse base the sharpest lobe does 
 a lobe narrower than declared) and costs at most a factor 1/(1 − w_c) in the pdf of a
 lobe the GGX part matches. Over four cases (GGX α = 0.2 with the exact proxy; the same
 plus a Lambertian 0.3; a proxy 2× too wide; 2× too narrow) the worst ratio of the
-standard deviation to the best w_c of its row is 1.37 at w_c = 0.2 (the exact proxy at
+standard deviation to the best w_c of its row is 1.36 at w_c = 0.2 (the exact proxy at
 θ_o = 0°, where 0.02 is best), 1.37 at 0.15, 1.71 at 0.1 (GGX + Lambert at 45°, where
 0.3 is best) and 1.69 at 0.3: 0.15–0.2 is the minimax, and 0.2 favours what user files
 usually are, a glossy lobe over a diffuse base.
