@@ -8,12 +8,12 @@ test configuration, Φ_L = 45°, E = 1, L_a = 0.2, ``path`` with max_depth 2, S�
 - ``built-in microfacet GGX (traced)``: ``brdfkit.model("microfacet", distribution="ggx",
   alpha=0.2, eta=…, k=…)``, its own formulas (Walter eq. 20 and the D cos θ_h sampler) —
   the baseline of the ratio column;
-- ``user-like Walter GGX (traced, proxy)``: the same formula as a user model defined in
+- ``user-like GGX, proxy sampler (traced)``: the same formula as a user model defined in
   this file — a formula kernel (``walter`` over microfacet's packed row, the per-channel
   η, κ as Color3f columns), declared lobe, ``formulas()`` =
   :func:`brdfkit.user.proxy_sampler.proxy_formulas` (cosine + GGX mixture, α from the
   lobe = 0.2, w_c = 0.2);
-- ``user-like Walter GGX, channel index (traced, proxy)``: the form the GLSL translator
+- ``user-like GGX, channel index (traced)``: the form the GLSL translator
   gives a coloured ``.brdf``: every row holds all three channels' η, κ and the channel
   index, the kernel computes F·D·G for r, g and b and keeps the row's with
   ``select(p[K-1] == 0.0, r, select(p[K-1] == 1.0, g, b))``;
@@ -23,21 +23,32 @@ test configuration, Φ_L = 45°, E = 1, L_a = 0.2, ``path`` with max_depth 2, S�
 - ``roughconductor (Mitsuba, symbolic)``: Mitsuba's own, for scale.
 
 Each row: median of ``--repeats`` renders after one warm-up render (kernel compilation),
-all rows in one process, side by side (``time_rows``/``report`` of
-``bench_render_mitsuba``: they also check that the images agree within 3 standard
-errors). Target: ratio ≤ 1.5.
+all rows in one process, side by side, interleaved (each round renders every row once, so
+the shared machine's load falls on all alike); the ratio of the medians and the median of
+the per-round ratios to the built-in row; the images must agree within 3 standard
+errors. Target: ratio ≤ 1.5.
 
 ``--weights`` prints instead the measurement behind the proxy's cosine weight w_c
 (:data:`brdfkit.user.proxy_sampler.COSINE_WEIGHT`): the standard deviation per sample of
 the albedo estimator f cos θ_i/p of four cases × θ_o ∈ {0°, 45°, 80°} × w_c.
 
-Measured (2-core Intel(R) Xeon(R) Processor, shared; 256², 16 spp, 7 repeats)::
+Measured (2-core "Intel(R) Xeon(R) Processor" of lscpu, shared, load average 4-6;
+256², 16 spp, 15 rounds; paired ratios of five runs, and one run at 512²)::
 
-    see the closing report of issue 21 (numbers printed by this script)
+    renderer                                   paired ratio to the built-in (traced)
+    user-like GGX, proxy sampler (traced)      0.95  1.07  0.97  0.96  1.00  | 512²: 0.97
+    user-like GGX, channel index (traced)      0.96  1.04  0.99  0.98  0.98  | 512²: 0.95
+    roughconductor (Mitsuba, symbolic)         0.92  1.00  0.91  0.89  1.03  | 512²: 0.90
+
+(median render 0.11-0.23 s under that load). The images agree (|z| < 1). Timed row after
+row instead (``time_rows`` of ``bench_render_mitsuba``), the rows drift with the others'
+jobs: the built-in row timed twice in one run read 1.00 and 1.17, and one early run at
+~0.04 s per render read 1.40 and 1.88 for the two user rows — hence the interleaved
+rounds and the paired ratio.
 
 Usage::
 
-    .venv/bin/python benchmarks/bench_user_render.py                # 256², 16 spp, 5 repeats
+    .venv/bin/python benchmarks/bench_user_render.py                # 256², 16 spp, 15 rounds
     .venv/bin/python benchmarks/bench_user_render.py --weights
 """
 
