@@ -31,6 +31,8 @@ References, each independent of the code under test:
   rejected); and against the wavefront route of the same model, which draws the same
   directions from the same random numbers (the same sampler formula, compiled by
   Numba): the same image to float32 rounding.
+- **Plugin**: ``{"type": "brdfkit", …}`` takes the traced route for such a model too
+  (its spec resolution replaced by the test model: the spec kinds are tested with them).
 """
 
 from __future__ import annotations
@@ -365,3 +367,24 @@ def test_traced_user_model_image(which):
     del s, wave
     gc.collect()
     np.testing.assert_allclose(same, imgs[:2], rtol=0, atol=2e-5 * imgs.max())
+
+
+def test_scene_dict_plugin_takes_the_traced_route(monkeypatch):
+    """{"type": "brdfkit", "model": SPEC}: the plugin builds the model from its spec (the
+    `.brdf`/`.py` spec kinds are the spec's; here the builder is replaced by the user-like
+    model) and takes the traced route, evaluating as the model does."""
+    import brdfkit.render.mitsuba_plugin as plugin
+
+    _llvm("llvm_ad_rgb")
+    model = user_rgb_model((0.7, 0.35, 0.1), 0.3)
+    # the spec is read (Mitsuba rejects an unreferenced property) and resolved to the model
+    monkeypatch.setattr(plugin, "_model_from_props",
+                        lambda props: ({"user-like.py": model}[props["model"]], None))
+    bsdf = mi.load_dict({"type": "brdfkit", "model": "user-like.py"})
+    assert bsdf.traced
+    view, light = _directions(np.random.default_rng(5), 16)
+    got = np.array(bsdf.eval(mi.BSDFContext(), _si(view),
+                             mi.Vector3f(light.T.astype(np.float32)))).T
+    np.testing.assert_allclose(got, model.eval(light, view) * light[:, 2:3], rtol=1e-4)
+    del bsdf
+    gc.collect()
