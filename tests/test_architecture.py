@@ -24,7 +24,7 @@ LAYER = {
     # material specs; brdfkit.spec builds a ModelSpec, applying its operators): layer 2,
     # so the data layer and the operators (pumping) are beside it and cli/figures above
     "": 2, "spec": 2, "models": 1,
-    "analysis": 2, "data": 2, "pumping": 2,
+    "analysis": 2, "data": 2, "pumping": 2, "user": 2,
     "fitting": 3, "render": 3,
     "figures": 4, "cli": 4, "report": 4, "explorer": 4, "__main__": 4,
 }

@@ -1,0 +1,1 @@
+"""Models from the user's own files (``.brdf`` files, Python files): layer 2."""
