@@ -207,9 +207,10 @@ from brdfkit.models._drivers import VECTOR_OPTIONS
 
 _NAN = float("nan")
 _INF = float("inf")
+_CACHE = "__file__" in globals()  # compiled code kept on disk when loaded from a file
 
 
-@formula(**VECTOR_OPTIONS)
+@formula(cache=_CACHE, **VECTOR_OPTIONS)
 def kernel(ix, iy, iz, ox, oy, oz, p):
 '''
 

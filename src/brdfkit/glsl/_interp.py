@@ -536,10 +536,14 @@ class _Interpreter:
                 return V.select(c, a, b)
             if t == "call_expression":
                 fn = node.child_by_field_name("function")
-                args = [self.expr(a) for a in _named(node.child_by_field_name("arguments"))]
                 if fn.type not in ("identifier", "type_identifier", "primitive_type"):
                     raise Failure(fn, f"a call of {fn.type.replace('_', ' ')} is not supported")
-                return self.call_named(_text(fn), args, node)
+                name = _text(fn)
+                if name not in self.functions and (name.startswith(("texture", "sampler"))
+                                                   or name in _UNSUPPORTED_CALLS):
+                    raise Failure(node, f"{name}() is not supported (textures and derivatives)")
+                args = [self.expr(a) for a in _named(node.child_by_field_name("arguments"))]
+                return self.call_named(name, args, node)
             if t == "field_expression":
                 v = self.expr(node.child_by_field_name("argument"))
                 fld = _text(node.child_by_field_name("field"))

@@ -97,10 +97,15 @@ def vector(nodes, base: str = "float", tags=NONE, why=None) -> Val:
     return Val(base, tuple(nodes), tags, why)
 
 
+_ODD_WHY = "a value that changes sign when the frame is mirrored (such as N·(L × V))"
+
+
 def _why(*vals: Val, reason: str | None = None) -> str | None:
     for v in vals:
         if v.why:
             return v.why
+    if any("odd" in v.tags for v in vals):
+        return _ODD_WHY
     return reason
 
 
@@ -372,7 +377,8 @@ def construct(base: str, n: int, args: list[Val]) -> Val:
         a = args[0]
         tags = (SCALARS if n > 1 else EVEN) if "even" in a.tags else (a.tags if n == 1
                                                                         else NONE)
-        return Val(base, a.comps * n, tags, a.why)
+        why = a.why if a.why or tags else _ODD_WHY
+        return Val(base, a.comps * n, tags, why)
     comps = [c for a in args for c in a.comps]
     if len(comps) < n:
         raise TypeProblem(f"{type_of(base, n)} needs {n} components; got {len(comps)}")
