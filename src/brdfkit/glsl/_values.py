@@ -255,6 +255,8 @@ def select(c: Val, a: Val, b: Val) -> Val:
     """``c ? a : b`` (both evaluated), component-wise; *c* a bool scalar."""
     if c.type != "bool":
         raise TypeProblem(f"a condition must be a bool; got {c.type}")
+    if c.comps[0].is_const and a.type == b.type:  # a constant choice: that side, as it is
+        return a if D.value_of(c.comps[0]) else b
     if a.type != b.type:
         if {a.base, b.base} == {"int", "float"} and a.n == b.n:
             a, b = _promote(a, b)

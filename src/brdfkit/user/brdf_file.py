@@ -242,6 +242,20 @@ def read_brdf_file(path) -> BrdfFile:
 
 
 # --------------------------------------------------------------------------- the model
+def _variant(path: str, params: tuple):
+    """The definition for the bools among a model's values (validated as parameters)."""
+    flags = {p.name: Param(p.name, p.default, kind="bool") for p in params if p.kind == "bool"}
+    if not flags:
+        return None
+    base = os.path.basename(path)
+
+    def variant(values: dict):
+        return definition(path, bools={k: flags[k].validate(v, base) for k, v in values.items()
+                                       if k in flags})
+
+    return variant
+
+
 def _declarations(f: BrdfFile) -> tuple:
     out = []
     for p in f.params:
@@ -348,7 +362,7 @@ def _build(f: BrdfFile, flags: dict):
         pack=pack, n_channels=3 if coloured else None, isotropic=tr.isotropic,
         isotropy_reason=tr.isotropy_reason + (f" (with {flag_text})" if flag_text else ""),
         reciprocal=None, energy_conserving=None, sampler=None,
-        citation=f"BRDF Explorer file {base}",
+        variant=_variant(f.path, f.params), citation=f"BRDF Explorer file {base}",
         summary=f"the BRDF of {base} (GLSL translated by brdfkit.glsl, {tr.n_nodes} "
                 "operations; float64)",
         notes=f.notes)

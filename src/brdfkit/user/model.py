@@ -177,6 +177,10 @@ class ModelDefinition:
     citation: str = ""
     summary: str = ""
     notes: tuple = field(default_factory=tuple)
+    #: ``variant(values) -> ModelDefinition`` or None: the definition for these values when
+    #: some parameters are compile-time constants of the kernel (a ``.brdf`` file's bools:
+    #: each combination has its own kernel); FormulaBRDF builds from it.
+    variant: Callable[[dict], ModelDefinition] | None = None
 
 
 # --------------------------------------------------------------------------- packing
@@ -335,6 +339,8 @@ class FormulaBRDF(TabulatedSampler, DerivedBRDF):
         if unknown:
             raise ParameterError(f"{definition.name}: unknown parameter {unknown[0]!r}; valid "
                                  "parameters: " + (", ".join(declared) or "none"))
+        if definition.variant is not None:  # compile-time parameters: their own kernel
+            definition = definition.variant(values)
         self._definition = definition
         self._measured: dict = {}
         super().__init__(name=definition.name, params=definition.params, values=values,
