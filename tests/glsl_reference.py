@@ -33,12 +33,17 @@ Public objects
 - :func:`compute_source` — the compute shader built from a file.
 - :class:`GlslBRDF` — a compiled file: ``GlslBRDF(path)(wi, wo, **params)`` → float32 (N, 3).
 - :func:`mesa_errors` — Mesa's compile errors for a file, as (line, column, message).
-- :func:`require_mesa` — the pytest fixture helper: the context, or a skip with the reason.
+- :func:`require_mesa` — the context, or a pytest skip with the reason; :data:`mesa`, the
+  fixture built on it (``from glsl_reference import mesa`` in a test module).
+- :func:`random_directions`, :func:`as_float32`, :func:`perturbation_spread`,
+  :func:`float32_bound`, :func:`worst_ratio` — the tests' sampling of pairs and their
+  float32 error model (:data:`RTOL`, :data:`SPREAD_FACTOR`, :data:`ATOL`).
 """
 
 from __future__ import annotations
 
 import functools
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,7 +51,12 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["Parameter", "BrdfSource", "read_brdf", "unavailable_reason", "compute_source",
-           "GlslBRDF", "mesa_errors", "require_mesa", "SETUP_HINT"]
+           "GlslBRDF", "mesa_errors", "require_mesa", "mesa", "random_directions", "as_float32",
+           "perturbation_spread", "float32_bound", "worst_ratio", "RTOL", "SPREAD_FACTOR",
+           "ATOL", "SETUP_HINT", "CORPUS"]
+
+#: The corpus of .brdf files (the project's own): good files here, bad ones in bad/.
+CORPUS = Path(__file__).resolve().parent / "brdf_files"
 
 SETUP_HINT = ("install moderngl (pip install moderngl glcontext) and Debian's "
               "libegl-mesa0 libgl1-mesa-dri libegl1 (scripts/setup.sh --test does both as root)")
@@ -303,3 +313,85 @@ class GlslBRDF:
             inp.release()
             res.release()
         return values.copy()
+
+
+# --------------------------------------------------------------------------- test helpers
+def random_directions(rng, n: int, *, theta_min_deg: float = 3.0,
+                      theta_max_deg: float = 87.0) -> np.ndarray:
+    """Uniform directions on the part of the upper hemisphere with θ in [min, max] degrees.
+
+    The tests keep away from the normal and the horizon by default: GLSL files take
+    acos of cosines (ill-conditioned at 1: δθ = δcos/sin θ) and divide by N·L, N·V
+    (ill-conditioned at 0), so float32 loses its precision there by construction.
+    """
+    ct = rng.uniform(np.cos(np.radians(theta_max_deg)), np.cos(np.radians(theta_min_deg)), n)
+    phi = rng.uniform(0.0, 2.0 * np.pi, n)
+    st = np.sqrt(1.0 - ct * ct)
+    return np.stack([st * np.cos(phi), st * np.sin(phi), ct], axis=-1)
+
+
+def as_float32(a) -> np.ndarray:
+    """*a* rounded to float32 and back to float64: the values the GPU actually sees."""
+    return np.asarray(a, dtype=np.float32).astype(np.float64)
+
+
+def perturbation_spread(model: GlslBRDF, wi, wo, **params) -> np.ndarray:
+    """Σ_k |Mesa(x + ulp_k e_k) − Mesa(x)| over the six coordinates x_k of (wi, wo), each
+    moved to the next float32 away from zero: how much float32 rounding of the directions
+    alone moves the shader's value at each pair (a first-order condition estimate), (N, 3).
+    """
+    wi = np.asarray(wi, dtype=np.float64)
+    wo = np.asarray(wo, dtype=np.float64)
+    base = model(wi, wo, **params).astype(np.float64)
+    total = np.zeros_like(base)
+    for which in (0, 1):
+        for k in range(3):
+            moved = [wi.copy(), wo.copy()]
+            x = moved[which][:, k].astype(np.float32)
+            moved[which][:, k] = np.nextafter(x, np.copysign(np.float32(np.inf), x))
+            total += np.abs(model(moved[0], moved[1], **params).astype(np.float64) - base)
+    return total
+
+
+#: Relative agreement expected of a float32 evaluation with a float64 one (issue 21 §5,
+#: "≈1e-5"): a shader of ~100 operations, each rounded to 2⁻²⁴ ≈ 6e-8, worst case summed.
+RTOL = 1e-5
+#: Multiple of :func:`perturbation_spread` added to the bound: rounding the directions to
+#: float32 moves the value by at most about half a spread, the intermediate roundings of
+#: O(1) quantities (dot products, H, R) by a few ulps of the same quantities; 8 leaves a
+#: margin. Where the shader
+#: is ill-conditioned (a pow with a large exponent, exp of a large argument, a sharp lobe)
+#: the spread is what float32 precision means there; elsewhere it is ~1e-7 relative.
+SPREAD_FACTOR = 8.0
+#: Absolute floor: float32's smallest normal number (values below are subnormal on a GPU).
+ATOL = 1.2e-38
+
+
+def float32_bound(a, b, spread, *, rtol: float = RTOL) -> np.ndarray:
+    """The allowed |a − b| of a float64 value *a* and its float32 (Mesa) value *b*."""
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    return rtol * np.maximum(np.abs(a), np.abs(b)) + SPREAD_FACTOR * np.asarray(spread) + ATOL
+
+
+def worst_ratio(a, b, spread, *, rtol: float = RTOL) -> float:
+    """max |a − b| / :func:`float32_bound` (≤ 1: agreement to float32 precision); NaN
+    anywhere in either gives inf (compare NaN positions separately)."""
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+        return math.inf
+    return float(np.max(np.abs(a - b) / float32_bound(a, b, spread, rtol=rtol), initial=0.0))
+
+
+def _fixture():
+    import pytest
+
+    @pytest.fixture(scope="session")
+    def mesa():
+        """The headless Mesa context; the test is skipped, saying why, when there is none."""
+        return require_mesa()
+
+    return mesa
+
+
+#: pytest fixture (import it into a test module: ``from glsl_reference import mesa``)
+mesa = _fixture()
