@@ -33,11 +33,11 @@ Public objects
 - :func:`compute_source` — the compute shader built from a file.
 - :class:`GlslBRDF` — a compiled file: ``GlslBRDF(path)(wi, wo, **params)`` → float32 (N, 3).
 - :func:`mesa_errors` — Mesa's compile errors for a file, as (line, column, message).
-- :func:`require_mesa` — the context, or a pytest skip with the reason; :data:`mesa`, the
-  fixture built on it (``from glsl_reference import mesa`` in a test module).
+- :func:`require_mesa` — the context, or a pytest skip with the reason (the body of the
+  test modules' ``mesa`` fixture).
 - :func:`random_directions`, :func:`as_float32`, :func:`perturbation_spread`,
   :func:`float32_bound`, :func:`worst_ratio` — the tests' sampling of pairs and their
-  float32 error model (:data:`RTOL`, :data:`SPREAD_FACTOR`, :data:`ATOL`).
+  float32 error model (:data:`RTOL`, :data:`ACOS_RTOL`, :data:`SPREAD_FACTOR`, :data:`ATOL`).
 """
 
 from __future__ import annotations
@@ -51,9 +51,9 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["Parameter", "BrdfSource", "read_brdf", "unavailable_reason", "compute_source",
-           "GlslBRDF", "mesa_errors", "require_mesa", "mesa", "random_directions", "as_float32",
-           "perturbation_spread", "float32_bound", "worst_ratio", "RTOL", "SPREAD_FACTOR",
-           "ATOL", "SETUP_HINT", "CORPUS"]
+           "GlslBRDF", "mesa_errors", "require_mesa", "random_directions", "as_float32",
+           "perturbation_spread", "float32_bound", "worst_ratio", "RTOL", "ACOS_RTOL",
+           "SPREAD_FACTOR", "ATOL", "SETUP_HINT", "CORPUS"]
 
 #: The corpus of .brdf files (the project's own): good files here, bad ones in bad/.
 CORPUS = Path(__file__).resolve().parent / "brdf_files"
@@ -356,6 +356,12 @@ def perturbation_spread(model: GlslBRDF, wi, wo, **params) -> np.ndarray:
 #: Relative agreement expected of a float32 evaluation with a float64 one (issue 21 §5,
 #: "≈1e-5"): a shader of ~100 operations, each rounded to 2⁻²⁴ ≈ 6e-8, worst case summed.
 RTOL = 1e-5
+#: Relative tolerance for files taking acos/asin of their cosines (oren_nayar.brdf): Mesa
+#: approximates them to 1.6e-4 / 3.9e-4 absolute (test_mesa_builtin_accuracy); θ enters
+#: the Oren-Nayar terms through sin, tan and products, measured ≤ 4.6e-4 relative in f
+#: (sigma ≤ 30°, θ ≤ 87°) against NumPy's float64 and against brdfkit.
+ACOS_RTOL = 1e-3
+
 #: Multiple of :func:`perturbation_spread` added to the bound: rounding the directions to
 #: float32 moves the value by at most about half a spread, the intermediate roundings of
 #: O(1) quantities (dot products, H, R) by a few ulps of the same quantities; 8 leaves a
@@ -380,18 +386,3 @@ def worst_ratio(a, b, spread, *, rtol: float = RTOL) -> float:
     if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
         return math.inf
     return float(np.max(np.abs(a - b) / float32_bound(a, b, spread, rtol=rtol), initial=0.0))
-
-
-def _fixture():
-    import pytest
-
-    @pytest.fixture(scope="session")
-    def mesa():
-        """The headless Mesa context; the test is skipped, saying why, when there is none."""
-        return require_mesa()
-
-    return mesa
-
-
-#: pytest fixture (import it into a test module: ``from glsl_reference import mesa``)
-mesa = _fixture()
