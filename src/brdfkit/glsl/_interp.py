@@ -15,9 +15,11 @@ nodes (:mod:`._dag`), so the result is the BRDF as one expression per colour cha
   every iteration; at most :data:`MAX_ITERATIONS`).
 - **Functions are inlined**: a call runs the callee's body on the argument values, in
   its own scopes (globals visible; writing a global is refused). A user function hides
-  every built-in of its name, as GLSL ≥ 1.30 scopes them (a file's own ``reflect`` with
-  the opposite sign is the one called); overloads are chosen by exact argument types,
-  then with int → float conversion. Recursion is refused.
+  every built-in of its name, as GLSL ≥ 1.30 scopes them and Mesa compiles them (a file's
+  own ``reflect`` with the opposite sign is the one called); overloads are chosen by exact argument types,
+  then with int → float conversion. A function is visible from its first declaration
+  (prototype or definition) on: a call above it reaches the built-in. Recursion is
+  refused.
 - Declarations: ``const`` and other globals, ``#define NAME VALUE`` (an object-like
   macro naming a constant expression), locals in block scopes, several declarators per
   line; uninitialised locals are 0.
@@ -136,6 +138,8 @@ class _Interpreter:
                                          for k, v in uniforms.items()}
         self.uniform_names = set(uniforms)
         self.functions: dict[str, list[_Function]] = {}
+        #: name → where it is first declared (a prototype or a definition), a byte offset
+        self.declared_at: dict[str, int] = {}
         self.frames: list[_Frame] = []
 
     # ------------------------------------------------------------ top level
@@ -143,6 +147,11 @@ class _Interpreter:
         for node in _named(self.root):
             if node.type == "function_definition":
                 self._define(node)
+            elif node.type == "declaration":
+                for d in _named(node):
+                    if d.type == "function_declarator":  # a prototype: declared from here
+                        fname = _text(d.child_by_field_name("declarator"))
+                        self.declared_at.setdefault(fname, node.start_byte)
         for node in _named(self.root):
             if node.type == "function_definition":
                 continue
@@ -180,6 +189,8 @@ class _Interpreter:
                 raise Failure(p, "a parameter must be a plain name (arrays are not supported)")
             params.append((_text(pname), ptype[0], ptype[1], p))
         fn = _Function(node, name, params, ret)
+        self.declared_at[name] = min(self.declared_at.get(name, node.start_byte),
+                                     node.start_byte)
         for other in self.functions.get(name, []):
             if [(b, n) for _, b, n, _ in other.params] == [(b, n) for _, b, n, _ in params]:
                 raise Failure(node, f"function {name!r} is defined twice with the same "
@@ -225,8 +236,14 @@ class _Interpreter:
         return frame.ret
 
     def call_named(self, name: str, args: list, node) -> V.Val:
+        # GLSL (as Mesa implements it): a user function is visible from its first
+        # declaration on, and from there hides every built-in of its name
         if name in self.functions:
-            return self.call(self._overload(name, args, node), args, node)
+            if node.start_byte >= self.declared_at.get(name, 0):
+                return self.call(self._overload(name, args, node), args, node)
+            if name not in BUILTINS:
+                raise Failure(node, f"{name!r} is called before it is declared (declare it "
+                                    "above, or write a prototype)")
         parsed = V.parse_type(name)
         if parsed is not None:
             try:
