@@ -282,13 +282,20 @@ def _albedo_nodes(kernel, P, thetas, phis, offsets, wo, vals, bad):  # pragma: n
 #: from it; every generated module calls its loop ``driver``: ``(wi, wo, P, out) -> n_bad``,
 #: except ``"albedo"``'s ``(P, thetas, phis, offsets, wo, vals, bad)``. ``"plain"`` is
 #: ``"checked"`` without the test (for arrays already checked).
+# Every loop divides as IEEE does (error_model "numpy"): the kernel is inlined into the
+# loop and compiled with the loop's options, and a user's formula (a .brdf file, a Python
+# model) may divide by zero where it makes a NaN or an infinity that the engines report —
+# Python's error model would raise ZeroDivisionError from inside the loop instead. For the
+# built-in kernels, which never divide by zero, the values are the same.
 LOOPS = {
-    "checked": ((("driver", eval_pairs_checked, "parallel=True"),), {"CHECK": True}),
-    "plain": ((("driver", eval_pairs_checked, "parallel=True"),), {"CHECK": False}),
+    "checked": ((("driver", eval_pairs_checked, 'parallel=True, error_model="numpy"'),),
+                {"CHECK": True}),
+    "plain": ((("driver", eval_pairs_checked, 'parallel=True, error_model="numpy"'),),
+              {"CHECK": False}),
     "vector": ((("chunk", _vector_chunk, "**VECTOR_OPTIONS"),
                 ("driver", _vector_loop, "parallel=True, **VECTOR_OPTIONS")), {}),
-    "blocked": ((("driver", _blocked_loop, "parallel=True"),), {}),
-    "albedo": ((("driver", _albedo_nodes, ""),), {}),
+    "blocked": ((("driver", _blocked_loop, 'parallel=True, error_model="numpy"'),), {}),
+    "albedo": ((("driver", _albedo_nodes, 'error_model="numpy"'),), {}),
 }
 
 
