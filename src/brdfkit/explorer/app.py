@@ -189,9 +189,9 @@ def create_app(*, opened=()):
         path = files.spec_file(entry["spec"])
         if path is None:
             return _cached(_key(entry), lambda: (build_entry(entry), {}))
-        key = _key(entry) + "|file|" + str(from_files.watcher.digest(path))
-        return _cached(key, lambda: from_files.build(
-            entry["spec"], path, _page_params(entry),
+        digest = from_files.watcher.digest(path)
+        return _cached(_key(entry) + "|file|" + str(digest), lambda: from_files.build(
+            entry["spec"], path, digest, _page_params(entry),
             lambda kept: entry_spec({**entry, "params": kept})))
 
     def get_model(entry: dict):

@@ -8,10 +8,10 @@ target itself is a file, or it is ``PATH.py:NAME`` and ``PATH.py`` is one) — a
 :data:`brdfkit.spec.KINDS` later: nothing here names a kind.
 
 - :class:`FileWatcher` — the files the shown models come from, polled by their
-  ``(mtime_ns, size)`` stamp and, when that moves (or is younger than
-  :data:`RACY_NS`), their content hash (SHA-256): a ``touch`` is not a change, two
-  writes of one size within a timestamp tick are. Each real change raises a version counter; the page asks
-  ``GET /api/changes?since=N`` every 300 ms and redraws when the version passed N.
+  ``(mtime_ns, size)`` stamp and, when that moves, their content hash (SHA-256): a
+  ``touch`` is not a change; two writes of one size within one timestamp tick (same
+  stamp) are seen when the stamp has aged past :data:`RACY_NS` (hashed once more). Each real change raises a version counter; the page asks
+  ``GET /api/changes?since=N`` every 100 ms and redraws when the version passed N.
   Polled on request (no thread: nothing runs while no page asks, nothing to stop).
 - :class:`FileModels` — builds a file-backed model keyed on the file's content
   (a changed file never returns the stale model), keeps the parameter values the new
@@ -51,14 +51,16 @@ from brdfkit.spec import KINDS, OPERATORS
 __all__ = ["spec_file", "runs_code", "check_open", "FileWatcher", "FileModels",
            "POLL_INTERVAL_S", "MAX_WATCHED"]
 
-#: A poll newer than this is reused: several pages polling every 300 ms stat each file
-#: about every 0.1 s at most (a stat costs ~2 µs; a hash only runs on a stamp change).
-POLL_INTERVAL_S = 0.1
+#: A poll newer than this is reused: several pages polling every 100 ms stat each file
+#: every 50 ms at most (a stat costs ~2 µs; a hash only runs on a stamp change).
+POLL_INTERVAL_S = 0.05
 #: Files watched at once: more than a page shows (8 models) across a few pages; the
 #: least recently used is forgotten first (it is watched again when shown again).
 MAX_WATCHED = 64
-#: A file modified less than this ago is hashed on every poll (mtime granularity is a
-#: kernel tick, ~4 ms, on ext4; 2 s also covers filesystems with coarse timestamps).
+#: A file last hashed less than this after its mtime may have been written again within
+#: the same timestamp tick (git's "racy" files): it is hashed once more when its stamp is
+#: this old. The tick is ~4 ms on ext4; 2 s also covers filesystems with coarse (1-2 s)
+#: timestamps. Once, not on every poll: hashing a 33 MB MERL table costs ~40-80 ms.
 RACY_NS = 2_000_000_000
 #: Suffixes whose loading executes the file (a Python model file).
 CODE_SUFFIXES = (".py",)
@@ -125,7 +127,8 @@ class FileWatcher:
 
     def __init__(self):
         self._lock = threading.Lock()
-        self._files: dict[str, list] = {}  # path -> [stamp, digest, version]; insertion = LRU
+        # path -> [stamp, digest, version of its last change, when hashed (ns)]; in LRU order
+        self._files: dict[str, list] = {}
         self._version = 0
         self._polled = -float("inf")
 
@@ -134,26 +137,27 @@ class FileWatcher:
         return self._version
 
     def _refresh(self, path: str, rec: list | None) -> list:
+        now = time.time_ns()
         try:
             st = os.stat(path)
             stamp = (st.st_mtime_ns, st.st_size)
         except OSError:
             stamp = None
-        # a stamp as recent as the filesystem's timestamp granularity may hide a second
-        # write of the same size within it (git's "racy" files): hashed again until it ages
-        racy = stamp is not None and time.time_ns() - stamp[0] < RACY_NS
-        if rec is not None and rec[0] == stamp and not racy:
-            return rec
+        if rec is not None and rec[0] == stamp:
+            # racy (RACY_NS): hashed before the stamp was RACY_NS old, and it is now
+            racy = stamp is not None and rec[3] < stamp[0] + RACY_NS <= now
+            if not racy:
+                return rec
         try:
             digest = None if stamp is None else _digest(path)
         except OSError:
             digest = None
         if rec is None:
-            return [stamp, digest, self._version]
+            return [stamp, digest, self._version, now]
         if digest != rec[1]:
             self._version += 1
-            return [stamp, digest, self._version]
-        return [stamp, digest, rec[2]]  # touched, same content: not a change
+            return [stamp, digest, self._version, now]
+        return [stamp, digest, rec[2], now]  # touched, same content: not a change
 
     def digest(self, path: str) -> str | None:
         """The content hash of *path* now (watching it from now on)."""
@@ -227,15 +231,15 @@ class FileModels:
             self._templates[key] = got
         return got
 
-    def build(self, target: str, path: str, params: dict, spec_of) -> tuple:
-        """``(model, info)`` of a file-backed target with the page's *params*; *spec_of*
+    def build(self, target: str, path: str, digest: str | None, params: dict, spec_of) -> tuple:
+        """``(model, info)`` of a file-backed target whose file at *path* has the content
+        hash *digest* (:meth:`FileWatcher.digest`) with the page's *params*; *spec_of*
         (params → :class:`~brdfkit.spec.ModelSpec`) gives the operators. *info*: ``file``
         (path), ``digest`` (12 hex), ``reload_error`` (the new version's error when the
         last good one is drawn, else None), ``dropped`` (parameter names the version does
         not declare), ``decl`` (the model's description: its parameters). Raises the
         load error when no version of the file has loaded yet."""
         self._check_allowed(target, path)
-        digest = self.watcher.digest(path)
         template = self._template(target, digest)
         error = None
         if isinstance(template, str):

@@ -14,9 +14,11 @@ let pending = null;
 let inflight = false;
 // spec -> {file, digest, decl, reload_error, reloaded}: what the server said of a file model
 const fileInfo = {};
-// Watched files are polled, not pushed: a 300 ms poll keeps a saved edit under a second away
-// (poll + reload + redraw) and holds no connection open; it survives a server restart.
-const POLL_MS = 300;
+// Watched files are polled, not pushed (server-sent events): a poll every 100 ms (a stat
+// per shown file, ~1 ms a request) keeps a saved edit well under a second away (poll +
+// reload + redraw: a 33 MB MERL table reads in ~0.1-0.2 s), holds no connection open,
+// needs no server thread and survives a server restart.
+const POLL_MS = 100;
 let since = null;  // the watch version the drawn views were built at
 
 function defaultState() {
