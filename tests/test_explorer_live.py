@@ -177,7 +177,8 @@ def test_api_opens_a_file_by_path_from_this_machine_only(tmp_path):
     _lambert_binary(p, 0.3)
     r = local.post("/api/open", json={"path": str(p)})
     assert r.status_code == 200 and r.json() == {"spec": str(p), "file": str(p)}
-    for path, says in ((str(tmp_path), "is a directory"), (str(tmp_path / "no.brdf"), "no such file"),
+    for path, says in ((str(tmp_path), "is a directory"),
+                       (str(tmp_path / "no.brdf"), "no such file"),
                        ("", "type the path"), (f"{tmp_path}/no.py:lam", "no such file")):
         r = local.post("/api/open", json={"path": path})
         assert r.status_code == 400 and says in r.json()["error"], (path, r.text)
@@ -199,7 +200,8 @@ def test_a_python_file_runs_only_once_the_user_named_it(tmp_path):
 
     py = tmp_path / "lam.py"
     marker = tmp_path / "ran"
-    py.write_text(f"open({str(marker)!r}, 'w').close()\n" + LAMBERT_PY.format(scale=1.0, name="rho"))
+    py.write_text(f"open({str(marker)!r}, 'w').close()\n"
+                  + LAMBERT_PY.format(scale=1.0, name="rho"))
     c = TestClient(create_app(), **LOCAL)
     state = {"models": [{"spec": str(py)}]}
     m = c.post("/api/views", json=state).json()["models"][0]
@@ -406,7 +408,8 @@ def test_page_opens_a_file_by_path(browser, server, tmp_path):
     assert page.locator("#open-error").text_content() == ""
     assert page.locator("#spheres img").count() == 2
     # its parameter (MeasuredBRDF's lookup) comes from the server's declaration
-    assert page.locator("#model-list .model").nth(1).locator("select[data-param='lookup']").count() == 1
+    box = page.locator("#model-list .model").nth(1)
+    assert box.locator("select[data-param='lookup']").count() == 1
     assert str(p) in urllib.parse.unquote(page.url)  # in the state: a link reopens it
     # Chromium logs the two refused opens (HTTP 400) as failed loads; nothing else
     assert [e for e in errors if "status of 400" not in e] == [] and len(errors) == 2
@@ -429,7 +432,8 @@ def test_page_brdf_file_live(browser, server, tmp_path):
     latency = time.perf_counter() - t0
     assert latency <= 1.0, latency
     t0 = time.perf_counter()
-    p.write_text(LAMBERT_BRDF.replace("0 1 0.5", "0 1 0.8").replace("rho / 3.14", "0.5 * rho / 3.14"))
+    p.write_text(LAMBERT_BRDF.replace("0 1 0.5", "0 1 0.8")
+                 .replace("rho / 3.14", "0.5 * rho / 3.14"))
     _wait_value(page, 0, 0.4 / math.pi, 60_000)
     print(f".brdf reload: default edit {latency:.2f} s, formula edit "
           f"{time.perf_counter() - t0:.2f} s")

@@ -10,7 +10,8 @@ target itself is a file, or it is ``PATH.py:NAME`` and ``PATH.py`` is one) — a
 - :class:`FileWatcher` — the files the shown models come from, polled by their
   ``(mtime_ns, size)`` stamp and, when that moves, their content hash (SHA-256): a
   ``touch`` is not a change; two writes of one size within one timestamp tick (same
-  stamp) are seen when the stamp has aged past :data:`RACY_NS` (hashed once more). Each real change raises a version counter; the page asks
+  stamp) are seen when the stamp has aged past :data:`RACY_NS` (hashed once more).
+  Each real change raises a version counter; the page asks
   ``GET /api/changes?since=N`` every 100 ms and redraws when the version passed N.
   Polled on request (no thread: nothing runs while no page asks, nothing to stop).
 - :class:`FileModels` — builds a file-backed model keyed on the file's content

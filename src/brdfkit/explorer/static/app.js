@@ -132,7 +132,7 @@ function paramControl(entry, p) {
   const slider = paramSlider(p, input);
   if (slider) label.appendChild(slider);
   const hint = document.createElement("small");
-  hint.textContent = " " + p.bounds;
+  hint.textContent = p.bounds ? " " + p.bounds : "";
   label.appendChild(hint);
   return label;
 }
@@ -170,8 +170,11 @@ function renderModelList() {
     box.className = "model";
     box.style.borderLeftColor = COLOURS[i % COLOURS.length];
     const head = document.createElement("div");
+    const info = fileInfo[entry.spec];
     const name = document.createElement("span");
-    name.className = "name"; name.textContent = entry.spec;
+    // a file model by its file's name (the whole path on the line below and in the title)
+    name.className = "name"; name.title = entry.spec;
+    name.textContent = info && info.file ? entry.spec.split("/").pop() : entry.spec;
     head.appendChild(name);
     const vis = document.createElement("input");
     vis.type = "checkbox"; vis.checked = entry.visible !== false; vis.title = "show";
@@ -186,7 +189,6 @@ function renderModelList() {
     rm.addEventListener("click", () => { state.models.splice(i, 1); state.solo = null; renderModelList(); update(); });
     head.appendChild(rm);
     box.appendChild(head);
-    const info = fileInfo[entry.spec];
     if (info && info.file) {
       const file = document.createElement("div");
       file.className = "file"; file.id = "model-file-" + i;
@@ -439,7 +441,8 @@ function drawAll() {
   drawPolar(ok); drawLobe(ok); drawCurves(ok); drawAlbedo(ok);
   drawImages("spheres", ok, "sphere"); drawImages("halfdiffs", ok, "halfdiff");
   const errors = lastViews.models.filter(v => v.error || v.reload_error)
-    .map(v => v.spec + ": " + (v.error || v.reload_error));
+    .map(v => { const e = v.error || v.reload_error;  // a file's error already names it
+                return e.startsWith(v.file || v.spec) ? e : v.spec + ": " + e; });
   showMessage(errors.concat(lastViews.notes || []).join(" · "));
 }
 
