@@ -483,3 +483,43 @@ def test_page_python_file_opened_by_path_and_live(browser, server, tmp_path):
     print(f".py reload (a default edit): {time.perf_counter() - t0:.2f} s")
     assert errors == []
     page.close()
+
+
+def test_explore_command_serves_file_specs(tmp_path):
+    """``brdfkit explore A.binary B.binary``: the printed address holds both as the page's
+    first models, and the server watches them (a save is one change for /api/changes)."""
+    import subprocess
+    import sys
+    import urllib.request
+
+    a, b = tmp_path / "a.binary", tmp_path / "b.binary"
+    _lambert_binary(a, 0.3)
+    _lambert_binary(b, 0.6)
+    port = _free_port()
+    proc = subprocess.Popen([sys.executable, "-m", "brdfkit", "explore", "--no-browser",
+                             "--port", str(port), "a.binary", str(b)], cwd=tmp_path,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        line = proc.stderr.readline()
+        url = line.split("serving on ", 1)[1].split(" ", 1)[0]
+        state = json.loads(urllib.parse.unquote(url.split("#", 1)[1]))
+        assert [m["spec"] for m in state["models"]] == ["a.binary", str(b)]
+        base = f"http://127.0.0.1:{port}"
+        for _ in range(100):
+            try:
+                urllib.request.urlopen(base + "/api/changes", timeout=5)
+                break
+            except OSError:
+                time.sleep(0.1)
+        req = urllib.request.Request(base + "/api/views", data=json.dumps(state).encode(),
+                                     headers={"Content-Type": "application/json"})
+        got = json.load(urllib.request.urlopen(req, timeout=120))
+        np.testing.assert_allclose([_slice0(m) for m in got["models"]],
+                                   [0.3 / math.pi, 0.6 / math.pi], rtol=1e-9)
+        assert got["models"][0]["file"] == str(a)  # relative to the server's directory
+        _lambert_binary(a, 0.4)
+        ch = json.load(urllib.request.urlopen(base + f"/api/changes?since={got['version']}"))
+        assert ch["changed"] == [str(a)]
+    finally:
+        proc.terminate()
+        proc.wait(timeout=30)
