@@ -166,7 +166,7 @@ def test_api_reloads_a_file_model_and_keeps_the_last_good(client, tmp_path):
     assert "polar" not in bad and str(q) in bad["error"] and bad["file"] == str(q)
 
 
-def test_api_opens_a_file_by_path_from_this_machine_only(tmp_path):
+def test_api_opens_a_file_by_path_from_this_machine_only(tmp_path, monkeypatch):
     from fastapi.testclient import TestClient
 
     from brdfkit.explorer.app import create_app
@@ -182,6 +182,8 @@ def test_api_opens_a_file_by_path_from_this_machine_only(tmp_path):
                        ("", "type the path"), (f"{tmp_path}/no.py:lam", "no such file")):
         r = local.post("/api/open", json={"path": path})
         assert r.status_code == 400 and says in r.json()["error"], (path, r.text)
+    monkeypatch.setenv("HOME", str(tmp_path))  # ~ expanded: the loaders read specs as paths
+    assert local.post("/api/open", json={"path": "~/lam.binary"}).json()["spec"] == str(p)
     r = remote.post("/api/open", json={"path": str(p)})  # not from 127.0.0.1
     assert r.status_code == 403 and "this machine" in r.json()["error"]
     r = local.post("/api/open", json={"path": str(p)}, headers={"origin": "http://evil.example"})

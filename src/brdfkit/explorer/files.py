@@ -73,7 +73,7 @@ def spec_file(target) -> str | None:
     when that is a ``.py`` file."""
     if not isinstance(target, str | os.PathLike):
         return None
-    t = os.path.expanduser(os.fspath(target).strip())
+    t = os.fspath(target).strip()
     if t and os.path.isfile(t):
         return os.path.abspath(t)
     head, sep, _ = t.rpartition(":")
@@ -88,18 +88,18 @@ def runs_code(path: str) -> bool:
 
 
 def check_open(text) -> tuple[str, str]:
-    """The page's "open file" input → ``(spec, absolute path)``; ``PATH.py:NAME`` keeps
-    its ``:NAME``. Raises :class:`DataFileError` for an empty input, a directory or a
-    path that is not a file, naming the path."""
+    """The page's "open file" input → ``(spec, absolute path)``: a leading ``~`` expanded
+    (the loaders read the spec as a path), ``PATH.py:NAME`` keeps its ``:NAME``. Raises
+    :class:`DataFileError` for an empty input, a directory or a path that is not a file,
+    naming the path."""
     if not isinstance(text, str) or not text.strip():
         raise DataFileError("open file: type the path of a model file on this machine "
                             "(.brdf, .py or .py:NAME, or a MERL .binary)")
-    spec = text.strip()
+    spec = os.path.expanduser(text.strip())
     path = spec_file(spec)
     if path is None:
-        bare = os.path.expanduser(spec)
-        head, sep, _ = bare.rpartition(":")
-        shown = head if sep and head.lower().endswith(CODE_SUFFIXES) else bare
+        head, sep, _ = spec.rpartition(":")
+        shown = head if sep and head.lower().endswith(CODE_SUFFIXES) else spec
         if os.path.isdir(shown):
             raise DataFileError(f"open file: {shown} is a directory; give the path of a "
                                 "model file in it")
