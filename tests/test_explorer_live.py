@@ -208,6 +208,9 @@ def test_a_python_file_runs_only_once_the_user_named_it(tmp_path):
     state = {"models": [{"spec": str(py)}]}
     m = c.post("/api/views", json=state).json()["models"][0]
     assert "a link cannot open it" in m["error"] and not marker.exists()
+    r = c.post("/api/fit", json={"model": {"spec": "lambert"}, "target": str(py)})
+    assert r.status_code == 400 and "a link cannot open it" in r.json()["error"]
+    assert not marker.exists()  # nor as a fit's target
     assert c.post("/api/open", json={"path": str(py)}).status_code == 200
     m = c.post("/api/views", json=state).json()["models"][0]
     assert "a link cannot open it" not in m.get("error", "")

@@ -342,7 +342,8 @@ def create_app(*, opened=()):
             raise BrdfkitError("fit: give {'model': {...}, 'target': SPEC, 'loss': ...}")
         loss = body.get("loss", "l1")
         m = get_model(body.get("model"))
-        target = ModelSpec(body["target"]).build()
+        # through the model cache and, for a file, its guard (a .py target runs only opened)
+        target = get_model({"spec": body["target"]})
         job_id = next(fit_ids)
         fits[job_id] = {"state": "running", "stage": "starting", "evaluations": 0,
                         "t0": time.perf_counter(), "model": m.name, "target": target.name}
