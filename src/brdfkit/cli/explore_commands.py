@@ -25,8 +25,13 @@ __all__ = ["explore_cmd"]
 def explore_cmd(specs, port, host, no_browser):
     """Open the explorer: models, pumped models and materials side by side in a browser.
 
-    SPEC... are the models shown first (model names or material specs such as
-    merl:nickel); more can be added in the page. Views: in-plane polar plot,
+    SPEC... are the models shown first (model names, material specs such as
+    merl:nickel, or files: my.brdf, model.py[:NAME], a MERL .binary); more can be
+    added in the page, a file by its path ("open file"). A file shown is watched:
+    saving an edit redraws it within a second, keeping the parameter values the
+    new version still has; a broken edit shows its error beside the last good
+    version. A .py model runs its code: only files named here or typed into the
+    page are loaded. Views: in-plane polar plot,
     3-D lobe, f against theta_h/theta_d/theta_o, theta_h x theta_d slice, the lit
     sphere of Lewis's test configuration, and the albedo curve with the
     plausibility verdict. Serves on 127.0.0.1 only unless --host is given;

@@ -13,6 +13,8 @@ canvases: no CDN, the page works offline) and a JSON API:
 ``POST /api/export/binary`` one model on the MERL grid (a ``.binary`` file)
 ``POST /api/fit``           start fitting a model to a material (background)
 ``GET  /api/fit/{id}``      its progress (stage, evaluations, loss) and result
+``POST /api/open``          ``{"path"}`` → ``{"spec"}``: a model file by path
+``GET  /api/changes``       ``?since=N`` → ``{"version", "changed"}``: watched files
 ==========================  =================================================
 
 A state is ``{"models": [{"spec", "params", "pump", "times", "visible"}],
@@ -21,7 +23,18 @@ in degrees, as on the command line), "mode": "luminance"|"rgb", "cosine": bool}`
 A model that cannot be built (unknown spec, parameter out of bounds, unreadable file) comes back as
 ``{"spec", "error"}`` and the page shows the message; the other models are
 drawn. Models are cached by their full description (a pumped model's tables
-are built once).
+are built once) and, for a model from a file, the file's content hash.
+
+Models from files (:mod:`brdfkit.explorer.files`): a spec whose target is a file
+(``.binary``, ``.brdf``, ``.py[:NAME]``) is watched; its entry in ``/api/views`` also
+has ``file``, ``digest``, ``decl`` (its parameter declarations: the page builds the
+controls from them), ``dropped`` (parameters the page sent that this version of the
+file does not declare; the page forgets them) and ``reload_error`` (the newest
+version's error while the last good version is drawn). ``version`` in the answer is
+the watch version before the models were built: the page polls ``/api/changes`` with
+it and redraws when a file changed. ``/api/open`` takes a request from this machine
+only and is the one way a Python file (which runs code) is loaded besides the command
+line (``files`` module docstring, "Security").
 
 Why FastAPI and not Panel: a slider move must redraw every view in 100 ms, and
 measured (``benchmarks/bench_explorer.py``, one analytic model) a direction move
@@ -40,18 +53,21 @@ import math
 import tempfile
 import threading
 import time
+import urllib.parse
 from importlib import resources
 from pathlib import Path
 
 from fastapi import FastAPI, Request
 from fastapi.responses import HTMLResponse, JSONResponse, Response
+from starlette.concurrency import run_in_threadpool
 
 from brdfkit._cache import bounded_cache
 from brdfkit._io import to_jsonable
 from brdfkit.data import material_names
+from brdfkit.data.catalog import MATERIAL_SOURCES
 from brdfkit.data.export import export_merl
 from brdfkit.errors import BrdfkitError
-from brdfkit.explorer import views
+from brdfkit.explorer import files, views
 from brdfkit.models import MODELS
 from brdfkit.spec import MAX_TIMES, ModelSpec
 
@@ -99,16 +115,36 @@ def entry_spec(entry: dict) -> ModelSpec:
     "pump", "times"}``: the spec's flat dict form with the page's conventions — the
     name under ``spec``, empty fields dropped, ``beta`` in degrees (as on the command
     line)."""
+    params = _page_params(entry)
+    if "beta" in params:  # degrees in the UI, as on the command line
+        params["beta"] = math.radians(float(params["beta"]))
+    return ModelSpec.from_dict({"model": entry["spec"], "params": params,
+                                **{k: entry[k] for k in ("pump", "times") if k in entry}})
+
+
+def _page_params(entry: dict) -> dict:
+    """An entry's parameters as the page sends them, empty fields dropped."""
     if not isinstance(entry, dict) or not isinstance(entry.get("spec"), str):
         raise BrdfkitError("each model entry needs a 'spec' string (a model name or material)")
     params = entry.get("params") or {}
     if not isinstance(params, dict):
         raise BrdfkitError(f"{entry['spec']}: params must be an object NAME: VALUE")
-    params = {k: v for k, v in params.items() if v is not None and v != ""}
-    if "beta" in params:  # degrees in the UI, as on the command line
-        params["beta"] = math.radians(float(params["beta"]))
-    return ModelSpec.from_dict({"model": entry["spec"], "params": params,
-                                **{k: entry[k] for k in ("pump", "times") if k in entry}})
+    return {k: v for k, v in params.items() if v is not None and v != ""}
+
+
+#: Names a request from this machine uses for the server (Host) and comes from (client).
+_LOOPBACK = ("127.0.0.1", "::1", "localhost")
+
+
+def _from_this_machine(request: Request) -> bool:
+    """The request comes from this machine, to a loopback name, and — when a browser
+    says which page sent it (``Origin``) — from the explorer's own page: another site
+    open in the browser cannot post it, nor a DNS-rebound name reach it."""
+    host = request.headers.get("host", "")
+    hostname = urllib.parse.urlsplit("//" + host).hostname or ""
+    origin = request.headers.get("origin")
+    return (request.client is not None and request.client.host in _LOOPBACK
+            and hostname in _LOOPBACK and origin in (None, f"http://{host}"))
 
 
 def build_entry(entry: dict):
@@ -129,11 +165,13 @@ def _b64(png: bytes) -> str:
     return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
 
 
-def create_app():
-    """The FastAPI application (one model cache per app)."""
+def create_app(*, opened=()):
+    """The FastAPI application (one model cache per app); *opened*: files the user named
+    (the command line's specs), which may run code (:mod:`brdfkit.explorer.files`)."""
     app = FastAPI(title="brdfkit explorer", docs_url=None, redoc_url=None)
     cache = bounded_cache(None, maxsize=_CACHE_SIZE)  # this app's models and views
     static = resources.files("brdfkit.explorer") / "static"
+    from_files = files.FileModels(opened=[p for p in map(files.spec_file, opened) if p])
 
     def _key(entry: dict) -> str:
         return json.dumps({k: entry.get(k) for k in ("spec", "params", "pump", "times")},
@@ -145,10 +183,21 @@ def create_app():
             got = cache[key] = make()
         return got
 
-    def get_model(entry: dict):
-        return _cached(_key(entry), lambda: build_entry(entry))
+    def get_built(entry: dict) -> tuple:
+        """``(model, info)``: *info* empty for a model not from a file (module docstring)."""
+        _page_params(entry)
+        path = files.spec_file(entry["spec"])
+        if path is None:
+            return _cached(_key(entry), lambda: (build_entry(entry), {}))
+        digest = from_files.watcher.digest(path)
+        return _cached(_key(entry) + "|file|" + str(digest), lambda: from_files.build(
+            entry["spec"], path, digest, _page_params(entry),
+            lambda kept: entry_spec({**entry, "params": kept})))
 
-    def model_only(entry: dict, m, mode: str, phi_i: float) -> dict:
+    def get_model(entry: dict):
+        return get_built(entry)[0]
+
+    def model_only(entry: dict, m, info: dict, mode: str, phi_i: float) -> dict:
         """Views that depend on the model alone (not on the direction or the light):
         computed once per model and channel mode, so moving θ_i, φ_i or Φ_L skips them
         (an anisotropic model's albedo curve is at φ_i: computed once per φ_i)."""
@@ -158,8 +207,8 @@ def create_app():
             png_h, hd = views.halfdiff(m)
             return {"albedo": views.albedo_curve(m, mode=mode, phi=phi),
                     "halfdiff": _b64(png_h), "halfdiff_info": hd}
-        return _cached(_key(entry) + "|views|" + mode + ("" if m.isotropic else f"|{phi!r}"),
-                       make)
+        return _cached(_key(entry) + "|" + info.get("digest", "") + "|views|" + mode
+                       + ("" if m.isotropic else f"|{phi!r}"), make)
 
     @app.exception_handler(BrdfkitError)
     async def _brdfkit_error(request: Request, exc: BrdfkitError):
@@ -188,18 +237,25 @@ def create_app():
     @app.get("/api/catalog")
     def catalog():
         return {"models": [cls.describe() for cls in MODELS.values()],
-                "materials": material_names(representations=True), "max_times": MAX_TIMES}
+                "materials": material_names(representations=True), "max_times": MAX_TIMES,
+                "material_sources": list(MATERIAL_SOURCES)}
 
     @app.post("/api/views")
     async def all_views(request: Request):
         s = parse_state(await _body(request))
+        # computed in a worker thread: the event loop keeps answering /api/changes
+        return await run_in_threadpool(compute_views, s)
+
+    def compute_views(s: dict) -> dict:
         t0 = time.perf_counter()
+        version = from_files.watcher.version
         out = []
         for entry in s["models"]:
             try:
-                m = get_model(entry)
+                m, info = get_built(entry)
                 png_s, sph = views.sphere(m, phi_l=s["phi_l"], ambient=s["ambient"])
                 out.append({
+                    **info,
                     "spec": entry.get("spec"), "name": m.name, "params": m.to_dict()["params"],
                     "polar": views.polar(m, s["theta_i"], s["phi_i"], cosine=s["cosine"],
                                          mode=s["mode"]),
@@ -208,15 +264,22 @@ def create_app():
                                            mode=s["mode"]),
                     "sphere": _b64(png_s), "sphere_info": sph,
                     "reciprocal_claim": m.reciprocal,
-                    **model_only(entry, m, s["mode"], s["phi_i"]),
+                    **model_only(entry, m, info, s["mode"], s["phi_i"]),
                 })
             except BrdfkitError as exc:
-                out.append({"spec": entry.get("spec"), "error": str(exc)})
-        return to_jsonable({"models": out, "ms": round(1e3 * (time.perf_counter() - t0), 1)})
+                spec = entry.get("spec") if isinstance(entry, dict) else None
+                path = files.spec_file(spec)
+                out.append({"spec": spec, "error": str(exc),
+                            **({"file": path} if path else {})})
+        return to_jsonable({"models": out, "version": version,
+                            "ms": round(1e3 * (time.perf_counter() - t0), 1)})
 
     @app.post("/api/verdict")
     async def verdicts(request: Request):
         s = parse_state(await _body(request))
+        return await run_in_threadpool(compute_verdicts, s)
+
+    def compute_verdicts(s: dict) -> dict:
         out = []
         for entry in s["models"]:
             try:
@@ -224,6 +287,22 @@ def create_app():
             except BrdfkitError as exc:
                 out.append({"spec": entry.get("spec"), "error": str(exc)})
         return to_jsonable({"verdicts": out})
+
+    @app.post("/api/open")
+    async def open_file(request: Request):
+        if not _from_this_machine(request):
+            return JSONResponse({"error": "open file: only the explorer's own page on this "
+                                          "machine (127.0.0.1) may open a file by path"},
+                                status_code=403)
+        body = await _body(request)
+        spec, path = files.check_open(body.get("path") if isinstance(body, dict) else None)
+        from_files.allow(path)  # the user typed it: it may run (a .py model)
+        return {"spec": spec, "file": path}
+
+    @app.get("/api/changes")
+    def changes(since: int = -1):
+        version = from_files.watcher.poll()
+        return {"version": version, "changed": from_files.watcher.changes(since)}
 
     @app.post("/api/export/binary")
     async def export_binary(request: Request):
@@ -267,7 +346,8 @@ def create_app():
             raise BrdfkitError("fit: give {'model': {...}, 'target': SPEC, 'loss': ...}")
         loss = body.get("loss", "l1")
         m = get_model(body.get("model"))
-        target = ModelSpec(body["target"]).build()
+        # through the model cache and, for a file, its guard (a .py target runs only opened)
+        target = get_model({"spec": body["target"]})
         job_id = next(fit_ids)
         fits[job_id] = {"state": "running", "stage": "starting", "evaluations": 0,
                         "t0": time.perf_counter(), "model": m.name, "target": target.name}

@@ -5,7 +5,10 @@
 :func:`serve` runs the app (:func:`brdfkit.explorer.app.create_app`) with
 uvicorn on **127.0.0.1** only — nobody else on the network can reach it unless
 ``host`` is given explicitly — opens the browser unless told not to, and stops
-cleanly on Ctrl-C (uvicorn's shutdown; no traceback).
+cleanly on Ctrl-C (uvicorn's shutdown; no traceback). The specs given are the
+page's first models; those that are files (``my.brdf``, ``model.py:NAME``, a MERL
+``.binary``) are watched and reloaded in the open page when saved, and a Python file
+named here may run (:mod:`brdfkit.explorer.files`).
 """
 
 from __future__ import annotations
@@ -64,7 +67,8 @@ def serve(*, specs=(), host: str = LOCALHOST, port: int = DEFAULT_PORT, open_bro
     where = ("this machine only" if host == LOCALHOST else
              f"every machine that can reach {host} (--host given)")
     log(f"brdfkit explore: serving on {url} ({where}); Ctrl-C stops")
-    config = uvicorn.Config(create_app(), host=host, port=port, log_level="warning")
+    config = uvicorn.Config(create_app(opened=specs), host=host, port=port,
+                            log_level="warning")
     server = uvicorn.Server(config)
     if open_browser:
         threading.Timer(1.0, lambda: webbrowser.open(url)).start()
