@@ -75,7 +75,7 @@ from brdfkit._kern import exp_nonpos
 
 __all__ = ["Formulas", "formula", "primitive", "drjit_version", "select", "sqrt", "exp", "log",
            "log1p", "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "power", "floor",
-           "minimum", "maximum", "absolute", "exp_nonpos"]
+           "minimum", "maximum", "absolute", "exp_nonpos", "numpy_version"]
 
 _jit = numba.njit(cache=True, inline="always")
 
@@ -222,9 +222,43 @@ def drjit_version(f) -> Callable:
     """
     import drjit as dr
 
+    return _version(f, _DRJIT, lambda value: _PRIMITIVES[value](dr), drjit_version)
+
+
+#: NumPy counterparts of the primitives (arrays in, arrays out): ``numpy_version``
+_NUMPY_PRIMITIVES = {select: np.where, minimum: np.minimum, maximum: np.maximum,
+                     absolute: np.abs, power: np.power, floor: np.floor}
+_NUMPY_BY_NAME = {"sqrt": np.sqrt, "exp": np.exp, "log": np.log, "log1p": np.log1p,
+                  "sin": np.sin, "cos": np.cos, "tan": np.tan, "asin": np.arcsin,
+                  "acos": np.arccos, "atan": np.arctan, "atan2": np.arctan2,
+                  "exp_nonpos": np.exp}
+#: memo: py_func → NumPy version
+_NUMPY = bounded_cache("brdfkit._dual._NUMPY", maxsize=256)
+
+
+def numpy_version(f) -> Callable:
+    """The NumPy version of the formula *f*: the same code with arrays (``select`` is
+    ``np.where``, ``sqrt`` ``np.sqrt`` …), so that a formula is evaluated without being
+    compiled (a just-edited ``.brdf`` file in the explorer, while Numba compiles it).
+    Raises ``TypeError`` as :func:`drjit_version`, also for a primitive with no NumPy
+    counterpart."""
+    def numpy_of(value):
+        if value in _NUMPY_PRIMITIVES:
+            return _NUMPY_PRIMITIVES[value]
+        name = next((k for k, v in _NUMPY_BY_NAME.items() if globals().get(k) is value), None)
+        if name is None:
+            raise TypeError(f"the primitive {value!r} has no NumPy version")
+        return _NUMPY_BY_NAME[name]
+
+    return _version(f, _NUMPY, numpy_of, numpy_version)
+
+
+def _version(f, memo, primitive_of, recurse) -> Callable:
+    """*f*'s code with its global names rebound: formulas by ``recurse``, primitives by
+    ``primitive_of``, numeric constants kept (the contract: module docstring)."""
     py = _py(f)
-    if py in _DRJIT:
-        return _DRJIT[py]
+    if py in memo:
+        return memo[py]
     if py not in _FORMULAS:
         raise TypeError(f"{py.__qualname__} is not a formula (decorate it with @formula)")
     code = py.__code__
@@ -234,18 +268,18 @@ def drjit_version(f) -> Callable:
                         "see brdfkit._dual)")
     ns: dict = {"__name__": py.__globals__.get("__name__"), "__builtins__": {}}
     new = types.FunctionType(code, ns, py.__name__, py.__defaults__)
-    _DRJIT[py] = new  # before the names: formulas may call each other
+    memo[py] = new  # before the names: formulas may call each other
     for name in code.co_names:
         value = py.__globals__.get(name)
         inner = _py(value) if value is not None else None
         if inner in _FORMULAS:
-            ns[name] = drjit_version(inner)
+            ns[name] = recurse(inner)
         elif _hashable(value) and value in _PRIMITIVES:
-            ns[name] = _PRIMITIVES[value](dr)
+            ns[name] = primitive_of(value)
         elif isinstance(value, _CONSTANT_TYPES):
             ns[name] = value
         else:
-            del _DRJIT[py]
+            del memo[py]
             what = type(value).__name__ if name in py.__globals__ else "a builtin"
             raise TypeError(f"formula {py.__qualname__} reads the global {name!r} "
                             f"({what}), which is neither a formula, a primitive nor a "
