@@ -107,11 +107,16 @@ def albedo_cmd(model, param, pump, times, theta, tol, as_json, as_csv, plot):
     e = np.asarray(r.error)
     if plot:
         _plot_albedo(th, a, m.name, plot)
+    # an angle that did not converge (e.g. NaN in the integrand) says so: the result's
+    # status and message, present only then (the output of converged runs is unchanged)
+    unconverged = {k: v for k, v in r.to_dict().items() if k in ("status", "message")}
     if as_json:
         emit_json({"model": d["model"], "params": d["params"],
                    **({"pump": d["pump"]} if "pump" in d else {}),
-                   "theta_deg": th, "albedo": a, "error": e})
+                   "theta_deg": th, "albedo": a, "error": e, **unconverged})
         return
+    if unconverged:
+        click.echo(f"brdfkit: warning: {unconverged['message']}", err=True)
     coloured = a.ndim == 2
     if as_csv:
         if coloured:
