@@ -16,6 +16,7 @@ malformed file names the file and the line.
 from __future__ import annotations
 
 import math
+import re
 
 import glsl_reference as ref
 import numpy as np
@@ -335,3 +336,50 @@ def test_mesa_builtin_accuracy(mesa, tmp_path, expr, fn, bounds, kind, bound):
         err = err / np.where(exact == 0.0, 1.0, np.abs(exact))
     worst = float(np.max(err))
     assert worst <= bound, f"{expr}: {kind} error {worst:.3g} > {bound:.3g}"
+
+
+# --------------------------------------------------------------------------- the corpus
+BUILTINS = ("dot cross normalize length reflect pow exp log sqrt inversesqrt sin cos tan asin "
+            "acos atan abs sign floor fract mod min max clamp mix step smoothstep radians "
+            "degrees").split()
+
+# (construct of issue 21 §1, a pattern that shows it in a shader): a guard that the corpus
+# keeps covering every construct the translator must handle (the files are compared with
+# Mesa in test_brdf_files)
+CONSTRUCTS = [
+    ("int local", r"\bint \w+ ="), ("bool local", r"\bbool \w+ ="),
+    ("vec2/vec3/vec4", r"\bvec2 \w+.*\n(.|\n)*\bvec4 \w+"),
+    ("swizzle read", r"\.[xyzw]{2,4}\b|\.bgr\b"), ("swizzle write", r"\.\w{2} = "),
+    ("component index", r"\w\[\d\]"), ("vec3(0)", r"vec3\(0\)"),
+    ("vec4(v3, 1.0)", r"vec4\(\w+, 1\.0\)"), ("vec2(v4)", r"vec2\(hom\)"),
+    ("implicit int -> float", r"1/PI|clamp\(1-u, 0, 1\)"),
+    ("const global", r"^const (float|vec3|int) ", ), ("+=", r"\+= "), ("-=", r"-= "),
+    ("*=", r"\*= "), ("/=", r"/= "), ("else if", r"else if"), ("early return", r"return .*;\n\s+}"),
+    ("ternary", r" \? "), ("&&", r"&&"), ("||", r"\|\|"), ("!", r"\(!\w"),
+    ("for loop", r"for \(int i = 1; i <= 5; i\+\+\)"), ("break", r"\bbreak;"),
+    ("user function shadowing a built-in", r"^vec3 reflect\(vec3 I, vec3 N\)"),
+    ("a prototype", r"\);\s+// from here on"),
+]
+
+
+def _shaders() -> str:
+    return "\n".join(ref.read_brdf(p).shader for p in sorted(CORPUS.glob("*.brdf")))
+
+
+@pytest.mark.parametrize("name", BUILTINS)
+def test_corpus_calls_every_builtin(name):
+    assert re.search(rf"(^|[^\w.]){name}\(", _shaders(), re.MULTILINE), name
+
+
+@pytest.mark.parametrize("what, pattern", CONSTRUCTS, ids=[c[0] for c in CONSTRUCTS])
+def test_corpus_has_every_construct(what, pattern):
+    assert re.search(pattern, _shaders(), re.MULTILINE), what
+
+
+def test_corpus_parameter_blocks_have_comments_blank_lines_bools_and_colours():
+    texts = {p.name: p.read_text() for p in CORPUS.glob("*.brdf")}
+    block = {n: t.split("::begin parameters")[1].split("::end parameters")[0]
+             for n, t in texts.items()}
+    assert any("\n#" in b for b in block.values())  # a comment inside a parameter block
+    kinds = {p.kind for n in texts for p in ref.read_brdf(CORPUS / n).params}
+    assert kinds == {"float", "bool", "color"}
