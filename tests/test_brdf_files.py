@@ -147,7 +147,7 @@ def test_file_agrees_with_mesa(mesa, name, rng):
 def test_corpus_covers_colour_bool_and_grey_files():
     kinds = {k for name in GOOD for k in (p.kind for p in ref.read_brdf(CORPUS / name).params)}
     assert kinds == {"float", "bool", "color"}
-    assert len(GOOD) >= 14
+    assert len(GOOD) >= 15
 
 
 def test_nan_reaches_the_value_not_a_silent_zero(mesa):

@@ -383,3 +383,18 @@ def test_corpus_parameter_blocks_have_comments_blank_lines_bools_and_colours():
     assert any("\n#" in b for b in block.values())  # a comment inside a parameter block
     kinds = {p.kind for n in texts for p in ref.read_brdf(CORPUS / n).params}
     assert kinds == {"float", "bool", "color"}
+
+
+def test_isfunc_section_runs_in_mesa(mesa, rng):
+    # lambert_sampled.brdf's sampleBRDF (BRDF Explorer's isFunc signature, out parameters):
+    # cosine-weighted directions, pdf = cos θ/π, value f cos θ/pdf = albedo (closed forms)
+    model = GlslBRDF(CORPUS / "lambert_sampled.brdf")
+    assert model.source.is_func and model.source.is_func_line > model.source.shader_line
+    u = rng.random((2000, 2))
+    value, wi, pdf = model.sample(u, albedo=[0.25, 0.5, 1.0])
+    np.testing.assert_allclose(value, np.broadcast_to([0.25, 0.5, 1.0], value.shape), rtol=1e-7)
+    np.testing.assert_allclose(np.linalg.norm(wi, axis=1), 1.0, rtol=1e-6)
+    np.testing.assert_allclose(wi[:, 2], np.sqrt(1.0 - u[:, 0]), rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(pdf, wi[:, 2] / math.pi, rtol=1e-5, atol=1e-7)
+    with pytest.raises(ValueError, match="no isFunc"):
+        GlslBRDF(CORPUS / "lambert.brdf").sample(u)
