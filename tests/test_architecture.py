@@ -20,11 +20,17 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "brdfkit"
 LAYER = {
     "errors": 0, "_array": 0, "_kern": 0, "geometry": 0, "fresnel": 0, "halfangle": 0,
     "tables": 0, "_io": 0, "_dual": 0, "status": 0, "_cache": 0, "_threads": 0, "colour": 0,
+    # glsl: the .brdf files' GLSL → formula source (issue 21; a translator, no models)
+    "glsl": 0,
     # the package root is the public facade (brdfkit.model resolves model names and
     # material specs; brdfkit.spec builds a ModelSpec, applying its operators): layer 2,
     # so the data layer and the operators (pumping) are beside it and cli/figures above
     "": 2, "spec": 2, "models": 1,
     "analysis": 2, "data": 2, "pumping": 2,
+    # user: models from the user's own files (.py, .brdf), built on models/ and data/
+    # (the tabulated sampler); formula: what a user's .py file imports (layer 1: _dual and
+    # Param); spec_words: the spec's NAME=VALUE parsing
+    "user": 2, "formula": 1, "spec_words": 2,
     "fitting": 3, "render": 3,
     "figures": 4, "cli": 4, "report": 4, "explorer": 4, "__main__": 4,
 }

@@ -206,7 +206,7 @@ def test_merl_file_spec(tmp_path):
 
 
 def test_tables_name_every_kind_and_operator():
-    assert [k.name for k in KINDS] == ["material", "merl-file", "model"]
+    assert [k.name for k in KINDS] == ["python-file", "brdf-file", "material", "merl-file", "model"]
     assert list(OPERATORS) == ["pump"]
     assert ModelSpec("nickel").kind == "model"  # the fallback claims the rest (then fails)
 

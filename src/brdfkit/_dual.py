@@ -36,7 +36,11 @@ name            Numba                           Dr.Jit
 select(c,a,b)   ``a if c else b``               ``dr.select``
 sqrt, exp, log  ``math.*``                      ``dr.*``
 log1p           ``math.log1p``                  Goldberg's log(1+x)·x/((1+x)−1)
-sin, cos        ``math.*``                      ``dr.*``
+sin, cos, tan,  ``math.*``                      ``dr.*``
+asin, acos,
+atan, atan2
+power(x, y)     ``x ** y``                      ``dr.power``
+floor           ``np.floor`` (a float)          ``dr.floor``
 minimum,        ``min``/``max``/``abs``         ``dr.minimum``/``maximum``/
 maximum,                                        ``abs``
 absolute
@@ -64,12 +68,14 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numba
+import numpy as np
 
 from brdfkit._cache import bounded_cache
 from brdfkit._kern import exp_nonpos
 
 __all__ = ["Formulas", "formula", "primitive", "drjit_version", "select", "sqrt", "exp", "log",
-           "log1p", "sin", "cos", "minimum", "maximum", "absolute", "exp_nonpos"]
+           "log1p", "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "power", "floor",
+           "minimum", "maximum", "absolute", "exp_nonpos"]
 
 _jit = numba.njit(cache=True, inline="always")
 
@@ -152,12 +158,29 @@ def absolute(a):
     return abs(a)
 
 
+@_jit
+def power(x, y):
+    """x**y (NaN for x < 0 and a non-integer y)."""
+    return x ** y
+
+
+@_jit
+def floor(x):
+    """The largest integer ≤ x, as a float (``math.floor`` gives an int)."""
+    return np.floor(x)
+
+
 sqrt = math.sqrt
 exp = math.exp
 log = math.log
 log1p = math.log1p
 sin = math.sin
 cos = math.cos
+tan = math.tan
+asin = math.asin
+acos = math.acos
+atan = math.atan
+atan2 = math.atan2
 
 
 def _log1p_drjit(dr):
@@ -173,6 +196,9 @@ for _obj, _factory in (
         (maximum, lambda dr: dr.maximum), (absolute, lambda dr: dr.abs),
         (sqrt, lambda dr: dr.sqrt), (exp, lambda dr: dr.exp), (log, lambda dr: dr.log),
         (log1p, _log1p_drjit), (sin, lambda dr: dr.sin), (cos, lambda dr: dr.cos),
+        (tan, lambda dr: dr.tan), (asin, lambda dr: dr.asin), (acos, lambda dr: dr.acos),
+        (atan, lambda dr: dr.atan), (atan2, lambda dr: dr.atan2),
+        (power, lambda dr: dr.power), (floor, lambda dr: dr.floor),
         (exp_nonpos, lambda dr: dr.exp)):
     primitive(_obj, _factory)
 

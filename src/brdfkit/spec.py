@@ -18,7 +18,10 @@ through it, so a model is described one way everywhere:
 - :meth:`ModelSpec.of` — the spec of a built model (``of(m).build()`` has its values);
 - :meth:`ModelSpec.build` — the model.
 
-What to build (:data:`KINDS`, the first kind that claims the name builds it): a
+What to build (:data:`KINDS`, the first kind that claims the name builds it): the
+model a user's Python file defines, ``PATH.py`` or ``PATH.py:NAME``
+(:mod:`brdfkit.user.python_file`); a BRDF Explorer file ``PATH.brdf``
+(:mod:`brdfkit.user.brdf_file`), both built as :class:`~brdfkit.user.model.FormulaBRDF`; a
 built-in measured material ``merl:NAME[@nbrdf|npf|abc|sgd]``, ``rgl:NAME``,
 ``nielsen:NAME`` (:func:`brdfkit.data.material`; no parameters); a MERL file
 ``PATH.binary`` (:class:`~brdfkit.data.MeasuredBRDF`, parameter ``lookup``); else a
@@ -56,7 +59,6 @@ Public objects
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
@@ -71,6 +73,7 @@ from brdfkit.data.catalog import (
 )
 from brdfkit.errors import BrdfkitError, ParameterError, UnknownModelError
 from brdfkit.models import BRDF, resolve
+from brdfkit.spec_words import parse_words, property_value
 
 __all__ = ["ModelSpec", "Operator", "model", "model_params", "canonical_name", "parse_items",
            "property_value", "times_problem", "is_material_spec", "KINDS", "SpecKind", "OPERATORS",
@@ -153,9 +156,46 @@ def _with_params(template, params: dict):
     return template.with_params(**params) if params else template
 
 
+def _path_text(name) -> str:
+    return os.fspath(name).strip() if isinstance(name, str | os.PathLike) else ""
+
+
+def _is_python_file(name) -> bool:
+    s = _path_text(name)
+    head, sep, tail = s.rpartition(":")
+    return s.lower().endswith(".py") or bool(sep and head.lower().endswith(".py")
+                                             and tail.isidentifier())
+
+
+def _is_brdf_file(name) -> bool:
+    return _path_text(name).lower().endswith(".brdf")
+
+
+# the user's files are read on first use (brdfkit.user: its loaders, Numba, the tabulated
+# sampler), not with the package
+def _python_definition(name):
+    from brdfkit.user.python_file import definition
+    return definition(_path_text(name))
+
+
+def _brdf_definition(name):
+    from brdfkit.user.brdf_file import definition
+    return definition(_path_text(name))
+
+
+def _user_model(definition, params: dict) -> BRDF:
+    from brdfkit.user.model import FormulaBRDF
+    return FormulaBRDF(definition, **params)
+
+
 #: What a spec builds, tried in order; the registered models claim every other name.
-#: A new kind (a ``.brdf`` file, a Python file's model) is one entry before the last.
+#: A new kind is one entry before the last; the user's files come first (a path object
+#: naming a ``.py``/``.brdf`` file is theirs, any other path a MERL file's).
 KINDS: tuple[SpecKind, ...] = (
+    SpecKind("python-file", "PATH.py or PATH.py:NAME (a model written in Python)",
+             _is_python_file, _python_definition, _user_model),
+    SpecKind("brdf-file", "PATH.brdf (a BRDF Explorer file)", _is_brdf_file, _brdf_definition,
+             _user_model),
     SpecKind("material", "merl:NAME[@nbrdf|@npf|@abc|@sgd], rgl:NAME, nielsen:NAME",
              _is_builtin, material, _with_params),
     SpecKind("merl-file", "PATH.binary (a MERL file)", _is_merl_file, _merl_file, _with_params),
@@ -171,9 +211,10 @@ def _kind(name) -> SpecKind:
 def model(name, /, **params) -> BRDF:
     """Build the model or material called *name* (module docstring) with *params*.
 
-    *name*: a registered model name or alias, a built-in material spec, or a path to
-    a MERL ``.binary`` file; *params* in API units (``beta`` in radians), omitted ones
-    at their defaults (built-in materials have none; a ``.binary`` file has ``lookup``).
+    *name*: a registered model name or alias, a built-in material spec, a path to a
+    MERL ``.binary`` file, a user's ``PATH.py[:NAME]`` or ``PATH.brdf``; *params* in API
+    units (``beta`` in radians), omitted ones at their defaults (built-in materials have
+    none; a ``.binary`` file has ``lookup``).
 
     Raises
     ------
@@ -182,7 +223,7 @@ def model(name, /, **params) -> BRDF:
     ParameterError
         A parameter the model does not declare, or a value outside its bounds.
     DataFileError
-        A ``.binary`` path that cannot be read.
+        A ``.binary`` path that cannot be read, a user's file that is malformed.
 
     Examples
     --------
@@ -204,22 +245,15 @@ def canonical_name(name) -> str:
 
 
 # --------------------------------------------------------------------------- words
-def _parse_number(text: str, name: str, label: str, bounds: str) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        raise ParameterError(
-            f"{label}: parameter {name!r} must be a number{bounds}; got {text!r}") from None
-
-
 def parse_items(name, items: Iterable[str] | Mapping, *, option: str = "-p") -> dict:
     """``NAME=VALUE`` words (as typed after *option*) → parameter values for *name*.
 
     Numbers; comma-separated numbers for per-channel colour or per-lobe
-    parameters; words for choice parameters; ``none`` for optional ones;
-    ``beta`` in degrees, in (0, 90), converted to radians. A mapping is taken
-    as already parsed (API units) and returned as a dict. A name the model does
-    not declare is kept as text: the model names it and lists the valid ones.
+    parameters; words for choice and bool parameters; ``none`` for optional ones;
+    ``beta`` in degrees, in (0, 90), converted to radians
+    (:func:`brdfkit.spec_words.parse_words`). A mapping is taken as already parsed
+    (API units) and returned as a dict. A name the model does not declare is kept
+    as text: the model names it and lists the valid ones.
 
     Raises
     ------
@@ -230,52 +264,9 @@ def parse_items(name, items: Iterable[str] | Mapping, *, option: str = "-p") -> 
         not a number.
     """
     template = _kind(name).resolve(name)
-    label = template.name
     if isinstance(items, Mapping):
         return dict(items)
-    decls = {p.name: p for p in template.params}
-    out: dict = {}
-    for item in items:
-        key, sep, text = str(item).partition("=")
-        key, text = key.strip(), text.strip()
-        if not sep or not key or not text:
-            raise ParameterError(
-                f"parameter must be given as NAME=VALUE (e.g. {option} rho_d=0.5); got {item!r}")
-        if key in out:
-            raise ParameterError(f"{label}: parameter {key!r} given twice")
-        if key == "beta":
-            deg = _parse_number(text, "beta", label, " of degrees in (0, 90)")
-            if not 0.0 < deg < 90.0:
-                raise ParameterError(
-                    f"{label}: parameter 'beta' (half-angle, degrees on the command line) "
-                    f"must lie in (0, 90); got {text}")
-            out[key] = math.radians(deg)
-            continue
-        p = decls.get(key)
-        if p is None:
-            out[key] = text
-            continue
-        bounds = f" in {p.bounds_text()}"
-        if p.optional and text.lower() in ("none", "null"):
-            out[key] = None
-        elif p.kind == "choice":
-            out[key] = text
-        elif p.kind in ("colour", "lobes") and "," in text:
-            out[key] = [_parse_number(t.strip(), key, label, bounds) for t in text.split(",")]
-        else:
-            out[key] = _parse_number(text, key, label, bounds)
-    return out
-
-
-def property_value(key: str, value, *, where: str):
-    """A flat property's value: a string with commas as a list of numbers, else as given."""
-    if not (isinstance(value, str) and "," in value):
-        return value
-    try:
-        return [float(x) for x in value.split(",")]
-    except ValueError:
-        raise ParameterError(f"{where}: property {key!r} must be a number, a word or a "
-                             f"comma-separated list of numbers; got {value!r}") from None
+    return parse_words(template.name, template.params, items, option=option)
 
 
 def times_problem(times) -> str | None:

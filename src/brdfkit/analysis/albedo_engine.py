@@ -33,7 +33,17 @@ estimate exceeds the tolerance every panel is halved in both directions and
 the angle recomputed (up to 5 times).
 
 Isotropic models are integrated over φ ∈ [0, φ_max] and doubled (mirror
-symmetry about the plane of incidence); plain callables over both halves.
+symmetry about the plane of incidence); anisotropic models (``isotropic`` False) and
+plain callables over both halves.
+
+Incidence azimuth. ω_i = (sin θ_i cos φ_i, sin θ_i sin φ_i, cos θ_i): the nodes are
+generated for ω_i at azimuth 0 and rotated about the normal by φ_i, with ω_i, where f is
+evaluated (the ``"albedo"`` loop of :mod:`brdfkit.models._drivers` and
+:func:`_callable_evaluator`: the one seam). Every frame above (mirror, half vector,
+normal) and every kink curve (N·V = N·L, the V-groove's, N·V = k) is built from ω_i and
+the normal only, so the rotated nodes are exactly the nodes of ω_i at φ_i. An isotropic
+model's albedo does not depend on φ_i (rotation invariance): it is recorded, not applied
+(the numbers are those of φ_i = 0, bit for bit).
 
 This is brdfkit's one albedo engine: every directional albedo brdfkit reports comes
 from it. The other estimators are second methods beside it, each in its own module:
@@ -44,11 +54,11 @@ hemispherical_albedo` (ρ_hh, an outer rule over this engine) and
 
 Public objects
 --------------
-- :class:`AlbedoResult` — θ_i, albedo, error estimate, status (``brdfkit.status``,
+- :class:`AlbedoResult` — θ_i, φ_i, albedo, error estimate, status (``brdfkit.status``,
   kind ``albedo``), ``success`` and ``message``.
 - :func:`albedo` — deterministic albedo of a model or callable.
-- :func:`evaluate_pairs`, :func:`check_theta`, :func:`lobe_frame` — shared with the
-  other estimators and the verdicts.
+- :func:`evaluate_pairs`, :func:`check_theta`, :func:`check_phi`, :func:`incident`,
+  :func:`lobe_frame` — shared with the other estimators and the verdicts.
 - :data:`CONVERGED`, :data:`MAX_LEVEL_REACHED`, :data:`NODE_CAP`, :data:`NONFINITE`,
   :data:`STATUS_MESSAGES` — the ``albedo`` codes of :data:`brdfkit.status.STATUS` and
   their messages with this engine's numbers.
@@ -88,8 +98,9 @@ from brdfkit.models._base import BRDF
 from brdfkit.models._drivers import generic_loop, loop_driver
 from brdfkit.status import STATUS
 
-__all__ = ["AlbedoResult", "albedo", "evaluate_pairs", "check_theta", "lobe_frame",
-           "STATUS_MESSAGES", "CONVERGED", "MAX_LEVEL_REACHED", "NODE_CAP", "NONFINITE"]
+__all__ = ["AlbedoResult", "albedo", "evaluate_pairs", "check_theta", "check_phi", "incident",
+           "lobe_frame", "STATUS_MESSAGES", "CONVERGED", "MAX_LEVEL_REACHED", "NODE_CAP",
+           "NONFINITE"]
 
 
 
@@ -145,11 +156,11 @@ STATUS_MESSAGES = {
 }
 
 
-def _integrate_chunk(evaluate, th, mode, width, level, sym, kinks, kvs, counts, npieces, a, e,
-                     bad, idx, tol) -> np.ndarray:
-    """One level for the angles ``th`` (results written to a[idx], e[idx]; bad[idx] counts
-    non-finite integrand values); returns the mask of angles whose error estimate is still
-    above the goal."""
+def _integrate_chunk(evaluate, th, ph, mode, width, level, sym, kinks, kvs, counts, npieces, a,
+                     e, bad, idx, tol) -> np.ndarray:
+    """One level for the angles ``th`` at azimuths ``ph`` (results written to a[idx], e[idx];
+    bad[idx] counts non-finite integrand values); returns the mask of angles whose error
+    estimate is still above the goal."""
     th = np.ascontiguousarray(th)
     lv = np.full(th.size, level, dtype=np.int64)
     offsets = np.zeros(th.size + 1, dtype=np.int64)
@@ -163,7 +174,7 @@ def _integrate_chunk(evaluate, th, mode, width, level, sym, kinks, kvs, counts, 
     gen = _gen_all_parallel if big else _gen_all_serial
     gen(mode, th, width, lv, sym, _X, _WK, _WGAUSS, offsets, wo, wk, wg, piece, kinks,
         np.ascontiguousarray(kvs))
-    vals, nbad = evaluate(th, offsets, wo)
+    vals, nbad = evaluate(th, np.ascontiguousarray(ph), offsets, wo)
     vals = np.ascontiguousarray(vals, dtype=np.float64)
     del wo
     aa = np.empty((th.size, vals.shape[1]))
@@ -176,14 +187,16 @@ def _integrate_chunk(evaluate, th, mode, width, level, sym, kinks, kvs, counts, 
     return np.any(ee > np.maximum(tol, 1e-10 * np.abs(aa)), axis=1) & (nbad == 0)
 
 
-def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool, tol: float,
-               n_channels: int, kinks: int = 0, levels_nv: np.ndarray | None = None
+def _integrate(evaluate, thetas: np.ndarray, phis: np.ndarray, mode: int, width: float,
+               sym: bool, tol: float, n_channels: int, kinks: int = 0,
+               levels_nv: np.ndarray | None = None
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Level loop shared by the compiled and the callable paths.
 
-    ``evaluate(thetas, offsets, wo) -> (vals (N, C), n_bad (T,))`` evaluates f at the
-    nodes and counts the non-finite values per angle. Returns (albedo, error, status);
-    an angle with non-finite values has albedo NaN, error inf, status NONFINITE.
+    ``evaluate(thetas, phis, offsets, wo) -> (vals (N, C), n_bad (T,))`` evaluates f at the
+    nodes (generated for azimuth 0, rotated by each angle's φ) and counts the non-finite
+    values per angle. Returns (albedo, error, status); an angle with non-finite values has
+    albedo NaN, error inf, status NONFINITE.
     """
     n = thetas.size
     kvs = (np.full((n, 0), np.nan) if levels_nv is None
@@ -217,9 +230,9 @@ def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool,
                 acc += int(counts[stop])
                 stop += 1
             idx = todo[start:stop]
-            above = _integrate_chunk(evaluate, thetas[idx], mode, width, level, sym, kinks,
-                                     kvs[idx], counts[start:stop], npieces[start:stop], a, e,
-                                     bad, idx, tol)
+            above = _integrate_chunk(evaluate, thetas[idx], phis[idx], mode, width, level, sym,
+                                     kinks, kvs[idx], counts[start:stop], npieces[start:stop],
+                                     a, e, bad, idx, tol)
             still.append(idx[above])
             start = stop
         todo = np.concatenate(still) if still else todo[:0]
@@ -236,12 +249,12 @@ def _integrate(evaluate, thetas: np.ndarray, mode: int, width: float, sym: bool,
 # --------------------------------------------------------------------------- public API
 @dataclass(frozen=True)
 class AlbedoResult:
-    """Directional albedo at the incidence angles θ_i.
+    """Directional albedo at the incidence directions (θ_i, φ_i).
 
     Attributes
     ----------
     theta : ndarray
-        θ_i in radians (shape of the input; 0-d for a scalar).
+        θ_i in radians (shape of the input, broadcast with φ_i; 0-d for a scalar).
     albedo : ndarray
         a(θ_i), shape ``theta.shape`` or ``theta.shape + (C,)`` for coloured models.
     error : ndarray
@@ -251,6 +264,11 @@ class AlbedoResult:
         :data:`NODE_CAP` (2) or :data:`NONFINITE` (3) — ``brdfkit.status.STATUS["albedo"]``;
         :data:`STATUS_MESSAGES` says what each means. Only CONVERGED angles meet the
         tolerance.
+    phi : ndarray
+        The incidence azimuth φ_i in radians, shape ``theta.shape`` (0 unless given).
+    anisotropic : bool
+        The model declares itself anisotropic (``isotropic`` False): its albedo depends
+        on φ_i, and :meth:`to_dict` always records it.
     success, message
         Whether every angle converged; one line saying which did not and why.
     """
@@ -259,11 +277,15 @@ class AlbedoResult:
     albedo: np.ndarray
     error: np.ndarray
     status: np.ndarray | None = None
+    phi: np.ndarray | float = 0.0
+    anisotropic: bool = False
 
     def __post_init__(self):
         st = (np.zeros(np.shape(self.theta), dtype=np.int8) if self.status is None
               else np.asarray(self.status, dtype=np.int8).reshape(np.shape(self.theta)))
         object.__setattr__(self, "status", st)
+        object.__setattr__(self, "phi", np.array(np.broadcast_to(
+            np.asarray(self.phi, dtype=np.float64), np.shape(self.theta))))
 
     @property
     def success(self) -> bool:
@@ -276,22 +298,29 @@ class AlbedoResult:
         if self.success:
             return STATUS_MESSAGES[CONVERGED]
         th = np.degrees(np.asarray(self.theta)).reshape(-1)
+        ph = np.degrees(self.phi).reshape(-1)
+        with_phi = bool(np.any(ph != 0.0))
         st = self.status.reshape(-1)
         parts = []
         for code in (MAX_LEVEL_REACHED, NODE_CAP, NONFINITE):
-            where = th[st == code]
+            where = np.flatnonzero(st == code)
             if where.size:
-                shown = ", ".join(f"{x:g}" for x in where[:5]) + (" ..." if where.size > 5
-                                                                  else "")
-                parts.append(f"theta_i = {shown} deg: {STATUS_MESSAGES[code]}")
+                shown = ", ".join((f"({th[k]:g}, {ph[k]:g})" if with_phi else f"{th[k]:g}")
+                                  for k in where[:5]) + (" ..." if where.size > 5 else "")
+                what = "(theta_i, phi_i)" if with_phi else "theta_i"
+                parts.append(f"{what} = {shown} deg: {STATUS_MESSAGES[code]}")
         return "; ".join(parts)
 
     def to_dict(self) -> dict:
         """JSON-ready: θ in degrees, albedo and error (per-channel lists when coloured), and,
-        when some angle did not converge, its ``status`` codes and ``message``."""
-        d = {"theta_deg": np.degrees(self.theta).tolist(),
-             "albedo": np.asarray(self.albedo).tolist(),
-             "error": np.asarray(self.error).tolist()}
+        when some angle did not converge, its ``status`` codes and ``message``; ``phi_deg``
+        (φ_i in degrees, shaped as ``theta_deg``) for an anisotropic model or when some φ_i
+        is not 0 (an isotropic model's JSON at φ_i = 0 is as it always was)."""
+        d = {"theta_deg": np.degrees(self.theta).tolist()}
+        if self.anisotropic or np.any(self.phi != 0.0):
+            d["phi_deg"] = np.degrees(self.phi).tolist()
+        d.update({"albedo": np.asarray(self.albedo).tolist(),
+                  "error": np.asarray(self.error).tolist()})
         if not self.success:
             d["status"] = self.status.tolist()
             d["message"] = self.message
@@ -354,6 +383,39 @@ def check_theta(theta_i, name: str = "theta_i") -> np.ndarray:
     return th
 
 
+def check_phi(phi, name: str = "phi") -> np.ndarray:
+    """*phi* (an azimuth) as float64 radians, any finite value (periodic);
+    :class:`ParameterError` naming *name*."""
+    try:
+        ph = np.asarray(phi, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be a number or an array of numbers (an azimuth in "
+                             f"radians, any finite value); got {phi!r}") from None
+    if not np.all(np.isfinite(ph)):
+        bad = ph[~np.isfinite(ph)].flat[0]
+        raise ParameterError(f"{name} must be finite (an azimuth in radians, any finite "
+                             f"value); got {bad!r}")
+    return ph
+
+
+def incident(theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """ω_i = (sin θ cos φ, sin θ sin φ, cos θ), shape ``broadcast(θ, φ) + (3,)``."""
+    theta, phi = np.broadcast_arrays(np.asarray(theta, dtype=np.float64),
+                                     np.asarray(phi, dtype=np.float64))
+    s = np.sin(theta)
+    return np.stack([s * np.cos(phi), s * np.sin(phi), np.cos(theta)], axis=-1)
+
+
+def _broadcast_angles(th: np.ndarray, ph: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """θ_i and φ_i broadcast to one shape; :class:`ParameterError` when they do not."""
+    try:
+        shape = np.broadcast_shapes(th.shape, ph.shape)
+    except ValueError:
+        raise ParameterError(f"phi must be a number or an array that broadcasts with theta_i; "
+                             f"got shapes {ph.shape} and {th.shape}") from None
+    return (np.array(np.broadcast_to(th, shape)), np.array(np.broadcast_to(ph, shape)))
+
+
 def _check_tol(tol: float) -> float:
     try:
         t = float(tol)
@@ -372,9 +434,9 @@ def _check_model(model, func: str) -> None:
                        f"f(wi, wo); got {type(model).__name__} {model!r}{hint}")
 
 
-def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
+def albedo(model, theta_i, *, phi=0.0, tol: float = 1e-7, mode: str | None = None,
            width: float | None = None) -> AlbedoResult:
-    """Directional albedo a(θ_i) = ∫ f_r(ω_i, ω_o) cos θ_o dω_o, deterministic.
+    """Directional albedo a(θ_i, φ_i) = ∫ f_r(ω_i, ω_o) cos θ_o dω_o, deterministic.
 
     Parameters
     ----------
@@ -382,9 +444,14 @@ def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
         A brdfkit model (integrated through its compiled kernel, in the frame
         of its sharpest lobe, with the kinks it declares) or any callable
         ``f(wi, wo) -> array`` taking broadcastable (..., 3) arrays and
-        returning (...) or (..., C). ω_i lies in the xz-plane at azimuth 0.
+        returning (...) or (..., C). ω_i = (sin θ_i cos φ_i, sin θ_i sin φ_i, cos θ_i).
     theta_i : float or array_like
         Incidence angles in radians, in [0, π/2).
+    phi : float or array_like, keyword-only
+        Incidence azimuth φ_i in radians (default 0: ω_i in the xz-plane), any finite
+        value, broadcast with *theta_i*. An anisotropic model (``isotropic`` False) and a
+        callable are integrated with ω_i at φ_i; an isotropic model's albedo does not
+        depend on it (the result records it; the numbers are those of φ_i = 0).
     tol : float, keyword-only
         Absolute accuracy goal (default 1e-7). Panels are halved until the
         error estimate meets it (or a relative 1e-10), at most 5 times.
@@ -408,7 +475,7 @@ def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
     Notes
     -----
     The model protocol (:class:`~brdfkit.models.BRDF`) is all the engine reads:
-    ``isotropic`` (integrate half the azimuths and double), ``albedo_kinks``
+    ``isotropic`` (integrate half the azimuths and double; φ_i not applied), ``albedo_kinks``
     (``"nv=nl"``, ``"vgroove"``: closed-form curves made panel edges),
     ``albedo_kinks_nv(theta)`` (up to 12 levels k of circles N·V = k per angle,
     e.g. where a pumped model's g switches branch; edges in every frame, closed
@@ -424,7 +491,7 @@ def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
     (True, True)
     """
     _check_model(model, "albedo")
-    th = check_theta(theta_i)
+    th, ph = _broadcast_angles(check_theta(theta_i), check_phi(phi))
     tol = _check_tol(tol)
     m_mode, m_width = lobe_frame(model)
     if mode is not None:
@@ -440,21 +507,26 @@ def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
             raise ParameterError(f"width must be a finite number > 0 (radians); got {width!r}")
         m_width = w
     flat = np.ascontiguousarray(th.reshape(-1))
+    anisotropic = isinstance(model, BRDF) and not model.isotropic
+    # the azimuth applied: an isotropic model is rotation invariant, so its nodes stay at 0
+    phis = (np.zeros(flat.size) if isinstance(model, BRDF) and model.isotropic
+            else np.ascontiguousarray(ph.reshape(-1)))
     if isinstance(model, BRDF):
         if model.kernel is not None:
             P = np.ascontiguousarray(np.asarray(model.packed, dtype=np.float64))
             nodes = loop_driver(model.kernel, loop="albedo")
 
-            def evaluate(th, offsets, wo):
+            def evaluate(th, ph, offsets, wo):
                 vals = np.empty((wo.shape[0], P.shape[0]))
                 bad = np.zeros(th.size, dtype=np.int64)
-                nodes(P, th, offsets, wo, vals, bad)
+                nodes(P, th, ph, offsets, wo, vals, bad)
                 return vals, bad
 
             n_channels = P.shape[0]
         else:
             evaluate, n_channels = _callable_evaluator(model.eval, "albedo: model.eval")
-        a, e, status = _integrate(evaluate, flat, m_mode, m_width, model.isotropic, tol,
+        # the mirror-symmetric half-azimuth shortcut only for an isotropic model
+        a, e, status = _integrate(evaluate, flat, phis, m_mode, m_width, model.isotropic, tol,
                                   n_channels, _kink_flags(model), _declared_levels(model, flat))
         coloured = model.n_channels is not None
         extra = model.specular_albedo(flat)
@@ -462,7 +534,7 @@ def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
             a = a + np.asarray(extra, dtype=np.float64).reshape(flat.size, -1)
     else:
         evaluate, n_channels = _callable_evaluator(model, "albedo: the callable")
-        a, e, status = _integrate(evaluate, flat, m_mode, m_width, False, tol, n_channels)
+        a, e, status = _integrate(evaluate, flat, phis, m_mode, m_width, False, tol, n_channels)
         coloured = evaluate.coloured
     if coloured:
         shape = th.shape + (a.shape[1],)
@@ -470,17 +542,23 @@ def albedo(model, theta_i, *, tol: float = 1e-7, mode: str | None = None,
         a, e = a[:, 0], e[:, 0]
         shape = th.shape
     return AlbedoResult(theta=th.copy(), albedo=a.reshape(shape), error=e.reshape(shape),
-                        status=status.reshape(th.shape))
+                        status=status.reshape(th.shape), phi=ph, anisotropic=anisotropic)
 
 
 def _callable_evaluator(f: Callable, what: str):
     """(evaluate, n_channels) for a NumPy-evaluated f: nodes built in Numba, f vectorised."""
 
-    def evaluate(th, offsets, wo):
+    def evaluate(th, ph, offsets, wo):
         idx = np.repeat(np.arange(th.size), np.diff(offsets))
         up = wo[:, 2] > 0.0  # unused slots and rounding below the horizon: not evaluated
-        wi = np.stack([np.sin(th[idx]), np.zeros(idx.size), np.cos(th[idx])], axis=-1)[up]
-        got = np.asarray(f(wi, np.ascontiguousarray(wo[up])), dtype=np.float64)
+        wi = incident(th[idx], ph[idx])[up]
+        wo_up = wo[up]
+        turn = ph[idx][up]
+        if np.any(turn != 0.0):  # the nodes rotated with ω_i by φ_i about the normal
+            c, s = np.cos(turn), np.sin(turn)
+            wo_up = np.stack([c * wo_up[:, 0] - s * wo_up[:, 1], s * wo_up[:, 0]
+                              + c * wo_up[:, 1], wo_up[:, 2]], axis=-1)
+        got = np.asarray(f(wi, np.ascontiguousarray(wo_up)), dtype=np.float64)
         if got.shape[:1] != (wi.shape[0],) or got.ndim > 2:
             raise BrdfkitError(f"{what} returned shape {got.shape} for "
                                f"{wi.shape[0]} direction pairs; expected (N,) or (N, C)")
@@ -496,5 +574,6 @@ def _callable_evaluator(f: Callable, what: str):
         return vals, bad
 
     evaluate.coloured = False
-    probe, _ = evaluate(np.array([0.0]), np.array([0, 1]), np.array([[0.0, 0.0, 1.0]]))
+    probe, _ = evaluate(np.array([0.0]), np.array([0.0]), np.array([0, 1]),
+                        np.array([[0.0, 0.0, 1.0]]))
     return evaluate, probe.shape[1]

@@ -8,6 +8,12 @@ with n-point Gauss–Legendre in u (smooth even when a ∝ μ^−p near grazing)
 directional albedos of the one engine (:func:`brdfkit.analysis.albedo`), and the
 n/2-point rule for the error estimate.
 
+An anisotropic model (``isotropic`` False) has a(θ_i, φ_i): ρ_hh = ∫₀¹ 4 ā(u²) u³ du with
+ā(θ_i) = (1/2π) ∫ a(θ_i, φ_i) dφ_i, the mean over the incidence azimuth by the
+trapezoidal rule on ``n_phi`` equally spaced azimuths (spectrally accurate for a smooth
+periodic function); the rule on every other azimuth adds its difference to the error
+estimate. An isotropic model's albedo does not depend on φ_i (one azimuth).
+
 Public objects
 --------------
 - :class:`HemisphericalAlbedo` — value, error estimate, status (``brdfkit.status``, kind
@@ -24,6 +30,7 @@ import numpy as np
 
 from brdfkit.analysis.albedo_engine import NONFINITE, _check_model, albedo
 from brdfkit.errors import ParameterError
+from brdfkit.models._base import BRDF
 from brdfkit.status import STATUS
 
 __all__ = ["HemisphericalAlbedo", "hemispherical_albedo"]
@@ -73,7 +80,8 @@ class HemisphericalAlbedo:
                 "status": int(self.status), "success": self.success, "message": self.message}
 
 
-def hemispherical_albedo(model, *, n: int = 48, tol: float = 1e-7) -> HemisphericalAlbedo:
+def hemispherical_albedo(model, *, n: int = 48, n_phi: int = 16,
+                         tol: float = 1e-7) -> HemisphericalAlbedo:
     """Hemispherical–hemispherical albedo ρ_hh = (1/π) ∫ a(ω_i) cos θ_i dω_i.
 
     With μ = cos θ_i = u², ρ_hh = ∫₀¹ a(μ) 2μ dμ = ∫₀¹ 4 a(u²) u³ du, computed with
@@ -85,6 +93,9 @@ def hemispherical_albedo(model, *, n: int = 48, tol: float = 1e-7) -> Hemispheri
     model : BRDF or callable
     n : int, keyword-only
         Nodes of the outer rule, in [2, 1000].
+    n_phi : int, keyword-only
+        Incidence azimuths of an anisotropic model's mean over φ_i (an even number in
+        [2, 1000]; unused for isotropic models and callables, which are taken at φ_i = 0).
     tol : float, keyword-only
         Accuracy goal of each directional albedo.
 
@@ -101,19 +112,30 @@ def hemispherical_albedo(model, *, n: int = 48, tol: float = 1e-7) -> Hemispheri
         # accuracy of the albedo itself (a is smooth in u = sqrt(cos theta_i))
         raise ParameterError(f"hemispherical_albedo: n must be an integer in [2, 1000]; "
                              f"got {n!r}")
+    if (isinstance(n_phi, bool) or not isinstance(n_phi, int | np.integer)
+            or not 2 <= n_phi <= 1000 or n_phi % 2):
+        # even: the rule on every other azimuth gives the error estimate
+        raise ParameterError(f"hemispherical_albedo: n_phi must be an even integer in "
+                             f"[2, 1000]; got {n_phi!r}")
     x, w = np.polynomial.legendre.leggauss(int(n))
     x2, w2 = np.polynomial.legendre.leggauss(int(n) // 2)
     us = np.concatenate([(x + 1) / 2, (x2 + 1) / 2])
     th = np.arccos(np.clip(us * us, 0.0, 1.0))
     th = np.minimum(th, math.pi / 2 - 1e-12)  # the node nearest grazing stays inside [0, π/2)
-    r = albedo(model, th, tol=tol)
-    a = np.asarray(r.albedo)
+    azimuthal = isinstance(model, BRDF) and not model.isotropic
+    n_az = int(n_phi) if azimuthal else 1
+    phis = 2.0 * math.pi * np.arange(n_az) / n_az
+    r = albedo(model, th[:, None], phi=phis[None, :], tol=tol)
+    a_all = np.asarray(r.albedo)  # (angles, azimuths[, C])
+    a = a_all.mean(axis=1)  # the trapezoidal rule of a periodic function
+    # its error: the rule on every other azimuth (no extra evaluation)
+    e_phi = np.abs(a - a_all[:, ::2].mean(axis=1)) if azimuthal else np.zeros_like(a)
     wt = 4.0 * us ** 3
     wt = wt.reshape(wt.shape + (1,) * (a.ndim - 1))
     aw = a * wt
     v1 = np.tensordot(w / 2, aw[: len(x)], axes=(0, 0))
     v2 = np.tensordot(w2 / 2, aw[len(x):], axes=(0, 0))
-    ew = np.asarray(r.error)[: len(x)] * wt[: len(x)]
+    ew = (np.asarray(r.error).max(axis=1) + e_phi)[: len(x)] * wt[: len(x)]
     err = np.abs(v1 - v2) + np.tensordot(w / 2, ew, axes=(0, 0))
     status, detail = _CODES.CONVERGED, ""
     if not r.success:  # an unconverged angle's estimate is not a bound

@@ -25,9 +25,12 @@ from brdfkit.analysis.albedo_engine import (
     CONVERGED,
     NONFINITE,
     AlbedoResult,
+    _broadcast_angles,
     _check_model,
+    check_phi,
     check_theta,
     evaluate_pairs,
+    incident,
 )
 from brdfkit.errors import ParameterError
 from brdfkit.models._base import BRDF
@@ -45,7 +48,7 @@ def _check_rng(rng) -> np.random.Generator:
                          f"or None; got {type(rng).__name__} {rng!r}")
 
 
-def albedo_mc(model, theta_i, *, n_samples: int = 100_000, rng=None,
+def albedo_mc(model, theta_i, *, phi=0.0, n_samples: int = 100_000, rng=None,
               defensive: float = 0.1) -> AlbedoResult:
     """Importance-sampled Monte-Carlo albedo with its standard error.
 
@@ -59,6 +62,9 @@ def albedo_mc(model, theta_i, *, n_samples: int = 100_000, rng=None,
     model : BRDF or callable
     theta_i : float or array_like
         Radians in [0, π/2).
+    phi : float or array_like, keyword-only
+        Incidence azimuth in radians (any finite value, broadcast with *theta_i*; default
+        0), applied to every model (ω_i = (sin θ cos φ, sin θ sin φ, cos θ)).
     n_samples : int, keyword-only
         Samples per angle (≥ 2).
     rng : int or numpy.random.Generator, keyword-only
@@ -75,7 +81,7 @@ def albedo_mc(model, theta_i, *, n_samples: int = 100_000, rng=None,
     from brdfkit.geometry import pdf_cosine_hemisphere, sample_cosine_hemisphere
 
     _check_model(model, "albedo_mc")
-    th = check_theta(theta_i)
+    th, ph = _broadcast_angles(check_theta(theta_i), check_phi(phi))
     if isinstance(n_samples, bool) or not isinstance(n_samples, int | np.integer) \
             or n_samples < 2:
         raise ParameterError(f"n_samples must be an integer >= 2; got {n_samples!r}")
@@ -91,8 +97,8 @@ def albedo_mc(model, theta_i, *, n_samples: int = 100_000, rng=None,
     if not has_sampler:
         defensive = 1.0
     vals_a, vals_e, status = [], [], []
-    for theta in th.reshape(-1):
-        wi = np.array([math.sin(theta), 0.0, math.cos(theta)])
+    for theta, azimuth in zip(th.reshape(-1), ph.reshape(-1), strict=True):
+        wi = incident(theta, azimuth)
         u = gen.random((n_samples, 2))
         pick = gen.random(n_samples) < defensive
         w = sample_cosine_hemisphere(u)
@@ -119,8 +125,9 @@ def albedo_mc(model, theta_i, *, n_samples: int = 100_000, rng=None,
         a = a + np.asarray(extra, dtype=np.float64).reshape(a.shape[0], -1)
     status = np.array(status, dtype=np.int8).reshape(th.shape)
     coloured = model.n_channels is not None if isinstance(model, BRDF) else a.shape[1] > 1
+    aniso = {"phi": ph, "anisotropic": isinstance(model, BRDF) and not model.isotropic}
     if not coloured and a.shape[1] == 1:
         return AlbedoResult(th.copy(), a[:, 0].reshape(th.shape), e[:, 0].reshape(th.shape),
-                            status)
+                            status, **aniso)
     return AlbedoResult(th.copy(), a.reshape(th.shape + (-1,)), e.reshape(th.shape + (-1,)),
-                        status)
+                        status, **aniso)

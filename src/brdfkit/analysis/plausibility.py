@@ -8,10 +8,16 @@ whether it conserves energy (Lewis §4–5, Neumann §2):
 - **Reciprocity** — the largest relative asymmetry
   |f(L,V) − f(V,L)| / max(f(L,V), f(V,L)) over a structured set of pairs
   (θ ∈ {0, 15, 30, 45, 60, 75, 85, 89, 89.9}°, both directions, five relative
-  azimuths including the mirror configuration). Reciprocal when ≤ 1e-6.
+  azimuths including the mirror configuration, L at azimuth 0). An anisotropic
+  model (``isotropic`` False) depends on the absolute azimuths too: L is placed at
+  seven absolute azimuths (0, 20, 45, 90, 135, 200, 290°, not symmetric about any
+  axis) and V at eight relative ones (every 45°, both sides of the plane of
+  incidence). Reciprocal when ≤ 1e-6. The set does not depend on the ``phi`` of
+  :func:`check`.
   Pairs where f is NaN in either order (unmeasured bins of a measured table)
   are left out and counted in the notes; *undetermined* when none is left.
-- **Energy** — the albedo a(θ_i) on 0…87° in 3° steps plus
+- **Energy** — the albedo a(θ_i) at the incidence azimuth ``phi`` (default 0; an
+  isotropic model's albedo does not depend on it) on 0…87° in 3° steps plus
   89°, 89.5°, 89.9°, 89.99°, 89.999°, refined about its maximum.
   *diverges*: a grows without bound as θ_i → 90°; the rate p of
   a ∝ (cos θ_i)^−p is the log–log slope between 89.99° and 89.999°, and the
@@ -24,7 +30,8 @@ whether it conserves energy (Lewis §4–5, Neumann §2):
   to the tolerance and its maximum is within its error estimate of 1 — no
   verdict is claimed that the accuracy cannot support; the notes say why.
 - **Other objections** detected numerically: radiance that always peaks at
-  the normal (Lewis §3.3–3.4 against Neumann–Neumann and Minnaert), albedo
+  the normal (Lewis §3.3–3.4 against Neumann–Neumann and Minnaert; in the plane of
+  incidence at ``phi``), albedo
   that collapses at grazing incidence (Neumann §1.2, the "dark Phong mirror").
 
 Every verdict has a ``status`` (``brdfkit.status.STATUS["verdict"]``): *converged*
@@ -52,8 +59,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from brdfkit.analysis.albedo_engine import albedo, evaluate_pairs
-from brdfkit.errors import BrdfkitError
+from brdfkit.analysis.albedo_engine import albedo, check_phi, evaluate_pairs
+from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models._base import BRDF
 from brdfkit.status import STATUS
 
@@ -64,6 +71,10 @@ CONSERVE_SLACK = 1e-6
 GRAZING_DEG = (89.0, 89.9, 89.99, 89.999)
 _PAIR_THETA_DEG = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 85.0, 89.0, 89.9)
 _PAIR_DPHI_DEG = (0.0, 45.0, 90.0, 135.0, 180.0)
+# anisotropic models: L at absolute azimuths with no symmetry between them (a model
+# symmetric about an axis cannot hide an asymmetry at all of them), V on both sides
+_ANISO_PHI_DEG = (0.0, 20.0, 45.0, 90.0, 135.0, 200.0, 290.0)
+_ANISO_DPHI_DEG = (0.0, 45.0, 90.0, 135.0, 180.0, 225.0, 270.0, 315.0)
 _CODES = STATUS["verdict"]
 
 
@@ -97,6 +108,10 @@ class Verdict:
     pump: dict | list | None = None
     status: int = 0
     detail: str = ""
+    #: The incidence azimuth of the energy part (radians), and whether the model is
+    #: anisotropic (then ``to_dict`` records ``phi_deg``; also when phi is not 0).
+    phi: float = 0.0
+    anisotropic: bool = False
 
     @property
     def reciprocal(self) -> bool:
@@ -132,6 +147,8 @@ class Verdict:
             "albedo_error": float(self.albedo_error),
             "min_albedo": float(self.min_albedo),
             "theta_min_deg": float(self.theta_min_deg),
+            **({"phi_deg": math.degrees(self.phi)}
+               if self.anisotropic or self.phi != 0.0 else {}),
             **({"pump": self.pump} if self.pump is not None else {}),
             "status": int(self.status),
             "success": self.success,
@@ -147,9 +164,16 @@ def _dirs(theta_deg, phi_deg) -> np.ndarray:
 
 def _reciprocity(model) -> tuple[float, int, int]:
     """(asymmetry over the pairs where both values exist, pairs without both, all pairs)."""
-    ti, to, dp = np.meshgrid(_PAIR_THETA_DEG, _PAIR_THETA_DEG, _PAIR_DPHI_DEG, indexing="ij")
-    L = _dirs(ti.ravel(), np.zeros(ti.size))
-    V = _dirs(to.ravel(), dp.ravel())
+    if model.isotropic:
+        ti, to, dp = np.meshgrid(_PAIR_THETA_DEG, _PAIR_THETA_DEG, _PAIR_DPHI_DEG,
+                                 indexing="ij")
+        pl = np.zeros(ti.size)
+    else:
+        ti, to, p0, dp = np.meshgrid(_PAIR_THETA_DEG, _PAIR_THETA_DEG, _ANISO_PHI_DEG,
+                                     _ANISO_DPHI_DEG, indexing="ij")
+        pl = p0.ravel()
+    L = _dirs(ti.ravel(), pl)
+    V = _dirs(to.ravel(), pl + dp.ravel())
     a = evaluate_pairs(model, L, V)
     b = evaluate_pairs(model, V, L)
     # a NaN value (e.g. an unmeasured bin of a measured table) is no evidence either way:
@@ -184,16 +208,16 @@ def divergence_rate(values: np.ndarray, theta_deg=GRAZING_DEG) -> list[float]:
     return out
 
 
-def _peaks_at_normal(model) -> bool:
+def _peaks_at_normal(model, phi_deg: float = 0.0) -> bool:
     """True when, for θ_i = 30°, 60°, 80°, f(L, V) over V in the plane of incidence peaks at V = N.
 
-    f is scanned over signed θ_o ∈ [−89°, 89°] in 0.5° steps (positive = the
-    mirror side). A flat f (Lambert) does not count as a peak.
+    L at azimuth *phi_deg*; f is scanned over signed θ_o ∈ [−89°, 89°] in 0.5° steps
+    (positive = the mirror side). A flat f (Lambert) does not count as a peak.
     """
     so = np.arange(-89.0, 89.0001, 0.5)
     for ti in (30.0, 60.0, 80.0):
-        L = _dirs(np.full(so.size, ti), np.zeros(so.size))
-        V = _dirs(np.abs(so), np.where(so >= 0.0, 180.0, 0.0))
+        L = _dirs(np.full(so.size, ti), np.full(so.size, phi_deg))
+        V = _dirs(np.abs(so), phi_deg + np.where(so >= 0.0, 180.0, 0.0))
         f = evaluate_pairs(model, L, V)
         for ch in range(f.shape[1]):
             col = f[:, ch]
@@ -206,7 +230,7 @@ def _peaks_at_normal(model) -> bool:
     return True
 
 
-def check(model, *, tol: float = 1e-7) -> Verdict:
+def check(model, *, tol: float = 1e-7, phi: float = 0.0) -> Verdict:
     """Reciprocity and energy verdict of *model*, computed (see the module docstring).
 
     Parameters
@@ -215,6 +239,11 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
         A brdfkit model (registered, pumped or otherwise derived).
     tol : float, keyword-only
         Albedo accuracy goal.
+    phi : float, keyword-only
+        Incidence azimuth of the energy part and the normal-peak scan, radians (any
+        finite value; default 0). An isotropic model's verdict does not depend on it;
+        the reciprocity pairs never do (an anisotropic model's cover seven absolute
+        azimuths).
 
     Returns
     -------
@@ -224,6 +253,15 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
         hint = (f" (build it first: brdfkit.model({model!r}))" if isinstance(model, str) else "")
         raise BrdfkitError(f"check: model must be a brdfkit model (BRDF); got "
                            f"{type(model).__name__} {model!r}{hint}")
+    ph = check_phi(phi)
+    if ph.ndim:
+        raise ParameterError(f"check: phi must be one number (radians); got an array of shape "
+                           f"{ph.shape}")
+    phi = float(ph)
+    # an isotropic model is rotation invariant: its scans stay at azimuth 0 (the same
+    # numbers for every phi)
+    phi_at = 0.0 if model.isotropic else phi
+    aniso = {"phi": phi, "anisotropic": not model.isotropic}
     d = model.to_dict()
     asym, n_missing, n_pairs = _reciprocity(model)
     if not math.isfinite(asym):
@@ -231,7 +269,7 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
     else:
         recip = "reciprocal" if asym <= RECIPROCITY_TOL else "not reciprocal"
     grid = np.concatenate([np.arange(0.0, 87.01, 3.0), [89.0, 89.5], GRAZING_DEG[1:]])
-    r = albedo(model, np.radians(grid), tol=tol)
+    r = albedo(model, np.radians(grid), phi=phi_at, tol=tol)
     a = np.asarray(r.albedo).reshape(grid.size, -1)
     err = float(np.max(np.asarray(r.error)))
     notes: list[str] = []
@@ -248,7 +286,7 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
             max_asymmetry=asym, energy="undetermined", max_albedo=float("nan"),
             theta_max_deg=float("nan"), divergence_exponent=None, max_scale=None, notes=notes,
             albedo_error=float("inf"), pump=d.get("pump"), status=_CODES.NONFINITE,
-            detail="energy undetermined: the albedo is NaN or infinite")
+            detail="energy undetermined: the albedo is NaN or infinite", **aniso)
 
     # --- divergence from the asymptotics, per channel
     ig = [int(np.argmin(np.abs(grid - g))) for g in GRAZING_DEG]
@@ -274,7 +312,8 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
     if p_est is None and 0 < k < grid.size - 1 and grid[k] < 89.0:
         lo, hi = grid[k - 1], grid[k + 1]
         fine = np.linspace(lo, hi, 13)
-        rf = np.asarray(albedo(model, np.radians(fine), tol=tol).albedo).reshape(fine.size, -1)
+        rf = np.asarray(albedo(model, np.radians(fine), phi=phi_at, tol=tol).albedo
+                        ).reshape(fine.size, -1)
         kf = int(np.argmax(rf.max(axis=1)))
         if rf.max(axis=1)[kf] > max_a:
             max_a = float(rf.max(axis=1)[kf])
@@ -311,7 +350,7 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
                          "(Lewis §4.2 b_j bound)")
 
     # --- other objections
-    peaks = _peaks_at_normal(model)
+    peaks = _peaks_at_normal(model, math.degrees(phi_at))
     if peaks:
         notes.append("reflected radiance always peaks at the normal (theta_r = 0) for every "
                      "incidence tested (Lewis §3.3-3.4 objection)")
@@ -338,5 +377,5 @@ def check(model, *, tol: float = 1e-7) -> Verdict:
         min_albedo=float(a.min(axis=1)[kmin]), theta_min_deg=float(grid[kmin]),
         pump=d.get("pump"),
         status=_CODES.UNDETERMINED if open_parts else _CODES.CONVERGED,
-        detail=", ".join(open_parts),
+        detail=", ".join(open_parts), **aniso,
     )

@@ -2,13 +2,18 @@
 Analysis commands: ``albedo``, ``check``, ``table2``, ``figure``
 ================================================================
 
-- ``brdfkit albedo MODEL -p ... [--theta 0:89.9:90] [--json|--csv] [--plot FILE]``
-- ``brdfkit check MODEL -p ... [--json]`` — reciprocity and energy verdicts.
+- ``brdfkit albedo MODEL -p ... [--theta 0:89.9:90] [--phi DEG] [--json|--csv] [--plot FILE]``
+- ``brdfkit check MODEL -p ... [--phi DEG] [--json]`` — reciprocity and energy verdicts.
 - ``brdfkit table2 [--json | --markdown]`` — Lewis's Table 2 for every model.
 - ``brdfkit figure NAME --out FILE`` — a paper figure (PNG or SVG);
   ``brdfkit figure list`` — the names.
 
-Angles are in degrees on the command line. Files are written atomically
+Angles are in degrees on the command line. ``--phi`` is the incidence azimuth
+(:func:`parse_phi`, default 0): an anisotropic model's albedo depends on it, and its
+JSON (``phi_deg``) and CSV (a ``phi_deg`` column) record it; an isotropic model's
+numbers do not depend on it, its output is unchanged at 0 and, given another value, the
+text output says in one line that it has no effect (the JSON then records ``phi_deg``).
+Files are written atomically
 (temp file + ``os.replace``). Plain click commands; :mod:`brdfkit.cli` adds
 them to the ``brdfkit`` group.
 """
@@ -23,7 +28,8 @@ from brdfkit.cli._common import build_model, emit_json, model_options
 from brdfkit.errors import BrdfkitError
 from brdfkit.spec import PUMP_CHOICES, is_material_spec
 
-__all__ = ["MAX_ANGLES", "parse_theta", "albedo_cmd", "check_cmd", "table2_cmd", "figure_cmd"]
+__all__ = ["MAX_ANGLES", "parse_theta", "parse_phi", "albedo_cmd", "check_cmd", "table2_cmd",
+           "figure_cmd"]
 
 #: Largest number of --theta angles. Each angle is an adaptive quadrature (milliseconds
 #: to seconds), so 100 000 is already hours of work and megabytes of output; the cap turns
@@ -73,20 +79,54 @@ def parse_theta(text: str) -> np.ndarray:
     return out
 
 
+def parse_phi(text: str) -> float:
+    """``--phi DEG``: the incidence azimuth, any finite number of degrees → degrees.
+
+    Raises
+    ------
+    BrdfkitError
+        Not a number, or not finite (nan, inf).
+    """
+    try:
+        value = float(str(text).strip())
+    except ValueError:
+        value = None
+    if value is None or not np.isfinite(value):
+        raise BrdfkitError(f"--phi must be a finite number of degrees (the incidence azimuth, "
+                           f"any finite value, e.g. --phi 45); got {text!r}")
+    return value
+
+
+_PHI_HELP = ("Incidence azimuth in DEGREES (any finite value; default 0: the light in the "
+             "xz-plane). Only an anisotropic model depends on it.")
+
+
+def _phi_note(m, phi_deg: float) -> str | None:
+    """The one line of text output saying that --phi has no effect on an isotropic model."""
+    if m.isotropic and phi_deg != 0.0:
+        return (f"--phi {phi_deg:g} has no effect: {m.name} is isotropic (its albedo does "
+                "not depend on the incidence azimuth)")
+    return None
+
+
 @click.command("albedo")
 @model_options
 @click.option("--theta", default="0:89.9:90", show_default=True, metavar="SPEC",
               help="Incidence angles in DEGREES, each in [0, 90): START:STOP:COUNT "
                    f"(inclusive) or a comma-separated list; at most {MAX_ANGLES} angles.")
+@click.option("--phi", "phi", default="0", metavar="DEG", help=_PHI_HELP)
 @click.option("--tol", type=float, default=1e-7, show_default=True,
               help="Absolute accuracy goal of the quadrature.")
 @click.option("--json", "as_json", is_flag=True,
-              help='Print {"model", "params", "theta_deg", "albedo", "error"}.')
-@click.option("--csv", "as_csv", is_flag=True, help="Print CSV: theta_deg, albedo(s), error(s).")
+              help='Print {"model", "params", "theta_deg", "albedo", "error"} (and "phi_deg" '
+                   'for an anisotropic model or a --phi other than 0).')
+@click.option("--csv", "as_csv", is_flag=True,
+              help="Print CSV: theta_deg, albedo(s), error(s) (a phi_deg column after "
+                   "theta_deg for an anisotropic model or a --phi other than 0).")
 @click.option("--plot", "plot", default=None, metavar="FILE",
               help="Also write a plot of a(theta_i) to FILE (.png or .svg; the directory "
                    "must exist).")
-def albedo_cmd(model, param, pump, times, theta, tol, as_json, as_csv, plot):
+def albedo_cmd(model, param, pump, times, theta, phi, tol, as_json, as_csv, plot):
     """Directional albedo a(theta_i) = int f_r cos(theta_o) dw_o of MODEL, with error estimates.
 
     Deterministic lobe-aware quadrature (accurate to ~1e-7). Example:
@@ -97,23 +137,28 @@ def albedo_cmd(model, param, pump, times, theta, tol, as_json, as_csv, plot):
 
     if as_json and as_csv:
         raise BrdfkitError("give at most one of --json and --csv")
+    phi_deg = parse_phi(phi)
     m = build_model(model, param, pump=pump, times=times)
     th = parse_theta(theta)
     if plot:
         check_output_path(plot, option="--plot")  # fail before the quadrature, not after
-    r = albedo(m, np.radians(th), tol=tol)
+    r = albedo(m, np.radians(th), phi=np.radians(phi_deg), tol=tol)
     d = m.to_dict()
     a = np.asarray(r.albedo)
     e = np.asarray(r.error)
+    # the azimuth is recorded where it matters or was asked for (isotropic output at 0 as
+    # it always was)
+    with_phi = not m.isotropic or phi_deg != 0.0
     if plot:
-        _plot_albedo(th, a, m.name, plot)
+        _plot_albedo(th, a, m.name, plot, phi_deg if with_phi else None)
     # an angle that did not converge (e.g. NaN in the integrand) says so: the result's
     # status and message, present only then (the output of converged runs is unchanged)
     unconverged = {k: v for k, v in r.to_dict().items() if k in ("status", "message")}
     if as_json:
         emit_json({"model": d["model"], "params": d["params"],
                    **({"pump": d["pump"]} if "pump" in d else {}),
-                   "theta_deg": th, "albedo": a, "error": e, **unconverged})
+                   "theta_deg": th, **({"phi_deg": phi_deg} if with_phi else {}),
+                   "albedo": a, "error": e, **unconverged})
         return
     if unconverged:
         click.echo(f"brdfkit: warning: {unconverged['message']}", err=True)
@@ -124,13 +169,18 @@ def albedo_cmd(model, param, pump, times, theta, tol, as_json, as_csv, plot):
                    [f"error_{c}" for c in range(a.shape[1])]
         else:
             cols = ["albedo", "error"]
-        click.echo(",".join(["theta_deg", *cols]))
+        click.echo(",".join(["theta_deg", *(["phi_deg"] if with_phi else []), *cols]))
         for k in range(th.size):
             vals = (list(a[k]) + list(e[k])) if coloured else [a[k], e[k]]
-            click.echo(",".join([f"{th[k]:.10g}"] + [f"{v:.12g}" for v in vals]))
+            click.echo(",".join([f"{th[k]:.10g}", *([f"{phi_deg:.10g}"] if with_phi else [])]
+                                + [f"{v:.12g}" for v in vals]))
         return
     click.echo(f"# {d['model']} {d['params']}")
-    click.echo("# theta_deg  albedo  (error estimate)")
+    note = _phi_note(m, phi_deg)
+    if note:
+        click.echo(f"# note: {note}")
+    click.echo("# theta_deg  albedo  (error estimate)"
+               + (f"  at phi = {phi_deg:g} deg" if not m.isotropic else ""))
     for k in range(th.size):
         if coloured:
             vals = "  ".join(f"{v:.9f}" for v in a[k])
@@ -139,7 +189,7 @@ def albedo_cmd(model, param, pump, times, theta, tol, as_json, as_csv, plot):
             click.echo(f"{th[k]:10.4f}  {a[k]:.9f}  ({e[k]:.1e})")
 
 
-def _plot_albedo(th, a, name, path):
+def _plot_albedo(th, a, name, path, phi_deg=None):
     import matplotlib
 
     matplotlib.use("Agg")
@@ -157,7 +207,8 @@ def _plot_albedo(th, a, name, path):
         ax.legend(fontsize=8)
     ax.set_xlabel(r"incidence angle $\theta_i$ (degrees)")
     ax.set_ylabel(r"albedo $a(\theta_i)$")
-    ax.set_title(f"directional albedo of {name}", fontsize=10)
+    ax.set_title(f"directional albedo of {name}"
+                 + ("" if phi_deg is None else f" at $\\phi_i$ = {phi_deg:g}°"), fontsize=10)
     ax.grid(alpha=0.3)
     try:
         save_atomic(fig, path, option="--plot")
@@ -167,11 +218,14 @@ def _plot_albedo(th, a, name, path):
 
 @click.command("check")
 @model_options
+@click.option("--phi", "phi", default="0", metavar="DEG",
+              help=_PHI_HELP + " Sets the azimuth of the energy verdict; the reciprocity "
+                   "pairs of an anisotropic model cover several azimuths whatever it is.")
 @click.option("--json", "as_json", is_flag=True,
               help='Print {"model", "params", "reciprocal", "max_asymmetry", "energy", '
                    '"max_albedo", "theta_max_deg", "divergence_exponent", "max_scale", '
                    '"notes", ...}.')
-def check_cmd(model, param, pump, times, as_json):
+def check_cmd(model, param, pump, times, phi, as_json):
     """Plausibility verdict of MODEL: reciprocity, energy conservation, objections.
 
     energy is 'conserves' (max albedo <= 1), 'exceeds' (bounded; max_scale is
@@ -180,13 +234,20 @@ def check_cmd(model, param, pump, times, as_json):
     """
     from brdfkit.analysis import check
 
+    phi_deg = parse_phi(phi)
     m = build_model(model, param, pump=pump, times=times)
-    v = check(m)
+    v = check(m, phi=np.radians(phi_deg))
     d = v.to_dict()
     if as_json:
         emit_json(d)
         return
     click.echo(f"model:        {d['model']}  {d['params']}")
+    if not m.isotropic:
+        click.echo(f"azimuth:      phi = {phi_deg:g} deg (anisotropic: the energy verdict is "
+                   "at this incidence azimuth)")
+    note = _phi_note(m, phi_deg)
+    if note:
+        click.echo(f"note:         {note}")
     recip = {"reciprocal": "yes", "not reciprocal": "no"}.get(d["reciprocity"],
                                                                 d["reciprocity"] or "no")
     click.echo(f"reciprocal:   {recip} "

@@ -148,14 +148,18 @@ def create_app():
     def get_model(entry: dict):
         return _cached(_key(entry), lambda: build_entry(entry))
 
-    def model_only(entry: dict, m, mode: str) -> dict:
+    def model_only(entry: dict, m, mode: str, phi_i: float) -> dict:
         """Views that depend on the model alone (not on the direction or the light):
-        computed once per model and channel mode, so moving θ_i, φ_i or Φ_L skips them."""
+        computed once per model and channel mode, so moving θ_i, φ_i or Φ_L skips them
+        (an anisotropic model's albedo curve is at φ_i: computed once per φ_i)."""
+        phi = 0.0 if m.isotropic else phi_i
+
         def make():
             png_h, hd = views.halfdiff(m)
-            return {"albedo": views.albedo_curve(m, mode=mode), "halfdiff": _b64(png_h),
-                    "halfdiff_info": hd}
-        return _cached(_key(entry) + "|views|" + mode, make)
+            return {"albedo": views.albedo_curve(m, mode=mode, phi=phi),
+                    "halfdiff": _b64(png_h), "halfdiff_info": hd}
+        return _cached(_key(entry) + "|views|" + mode + ("" if m.isotropic else f"|{phi!r}"),
+                       make)
 
     @app.exception_handler(BrdfkitError)
     async def _brdfkit_error(request: Request, exc: BrdfkitError):
@@ -204,7 +208,7 @@ def create_app():
                                            mode=s["mode"]),
                     "sphere": _b64(png_s), "sphere_info": sph,
                     "reciprocal_claim": m.reciprocal,
-                    **model_only(entry, m, s["mode"]),
+                    **model_only(entry, m, s["mode"], s["phi_i"]),
                 })
             except BrdfkitError as exc:
                 out.append({"spec": entry.get("spec"), "error": str(exc)})
@@ -216,7 +220,7 @@ def create_app():
         out = []
         for entry in s["models"]:
             try:
-                out.append(views.verdict(get_model(entry)))
+                out.append(views.verdict(get_model(entry), phi=s["phi_i"]))
             except BrdfkitError as exc:
                 out.append({"spec": entry.get("spec"), "error": str(exc)})
         return to_jsonable({"verdicts": out})

@@ -169,10 +169,12 @@ def sphere(model, *, phi_l: float, ambient: float = 0.0, size: int = 256,
     return png_bytes(img), {"exposure": exposure}
 
 
-def albedo_curve(model, *, n: int = 90, tol: float = ALBEDO_TOL, mode: str = "luminance"):
-    """a(θ_i) at *n* angles in [0, 89.5]°: ``{"theta_deg", "values", "error", "success"}``."""
+def albedo_curve(model, *, n: int = 90, tol: float = ALBEDO_TOL, mode: str = "luminance",
+                 phi: float = 0.0):
+    """a(θ_i) at *n* angles in [0, 89.5]° and the incidence azimuth *phi* (radians; only an
+    anisotropic model depends on it): ``{"theta_deg", "values", "error", "success"}``."""
     th = np.linspace(0.0, 89.5, n)
-    r = albedo(model, np.radians(th), tol=tol)
+    r = albedo(model, np.radians(th), phi=phi, tol=tol)
     return {"theta_deg": th.round(4).tolist(), "values": channels(r.albedo, mode),
             "error": float(np.max(r.error)), "success": bool(np.all(r.success)),
             "message": r.message}
@@ -183,6 +185,7 @@ def albedo_curve(model, *, n: int = 90, tol: float = ALBEDO_TOL, mode: str = "lu
 VERDICT_TOL = 1e-5
 
 
-def verdict(model, *, tol: float = VERDICT_TOL) -> dict:
-    """The plausibility verdict as ``brdfkit check --json`` prints it (albedo to *tol*)."""
-    return {**check(model, tol=tol).to_dict(), "tol": tol}
+def verdict(model, *, tol: float = VERDICT_TOL, phi: float = 0.0) -> dict:
+    """The plausibility verdict as ``brdfkit check --json`` prints it (albedo to *tol*, at
+    the incidence azimuth *phi*, radians: only an anisotropic model's depends on it)."""
+    return {**check(model, tol=tol, phi=0.0 if model.isotropic else phi).to_dict(), "tol": tol}

@@ -36,7 +36,8 @@ def _channel_mean(values: np.ndarray, n: int) -> np.ndarray:
     return v.mean(axis=1)
 
 
-def model_slices(*models, theta_i_deg=SLICE_THETA_I_DEG, n_points: int = 721):
+def model_slices(*models, theta_i_deg=SLICE_THETA_I_DEG, n_points: int = 721,
+                 phi_deg: float = 0.0):
     """In-plane slices f_r(θ_i; θ_o) and the albedo a(θ_i) of each model.
 
     Parameters
@@ -48,6 +49,10 @@ def model_slices(*models, theta_i_deg=SLICE_THETA_I_DEG, n_points: int = 721):
     n_points : int, keyword-only
         Points per slice (view angle from −90° to 90° in the plane of incidence;
         negative = the light's side).
+    phi_deg : float, keyword-only
+        Azimuth of the plane of incidence, degrees (any finite value; default 0, the
+        xz-plane), for the slices and the albedo; the title states it when a model is
+        anisotropic or it is not 0 (an isotropic model's figure does not depend on it).
 
     Left: f_r in 1/sr on a log scale, in the plane of incidence (φ_o − φ_i = π
     for positive θ_o: the mirror side). Right: a(θ_i) from
@@ -62,19 +67,33 @@ def model_slices(*models, theta_i_deg=SLICE_THETA_I_DEG, n_points: int = 721):
     if th_i.size == 0 or not np.all((th_i >= 0.0) & (th_i < 90.0)):
         raise ParameterError(f"model_slices: theta_i_deg must be angles in [0, 90) degrees; "
                              f"got {list(np.asarray(theta_i_deg).ravel())}")
+    try:
+        phi = float(phi_deg)
+    except (TypeError, ValueError):
+        phi = float("nan")
+    if not np.isfinite(phi):
+        raise ParameterError(f"model_slices: phi_deg must be a finite number of degrees; got "
+                             f"{phi_deg!r}")
+    phi_deg = phi
+    # the plane of incidence at azimuth phi: its in-plane axis (c, s, 0); at 0 exactly the
+    # xz-plane (no rounding of cos/sin, so the figure is as it was before the azimuth)
+    c, s = ((1.0, 0.0) if phi_deg == 0.0
+            else (np.cos(np.radians(phi_deg)), np.sin(np.radians(phi_deg))))
     fig, (ax_s, ax_a) = plt.subplots(1, 2, figsize=(11.0, 4.2))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     t_o = np.radians(np.linspace(-89.9, 89.9, n_points))
-    wo = np.stack([np.sin(t_o), np.zeros_like(t_o), np.cos(t_o)], axis=-1)
+    wo = np.stack([np.sin(t_o) * c, np.sin(t_o) * s if s else np.zeros_like(t_o),
+                   np.cos(t_o)], axis=-1)
     for m, style in zip(models, _STYLES, strict=False):
         for k, t in enumerate(np.radians(th_i)):
             # the light at azimuth π (x < 0) so that the mirror direction has θ_o = +θ_i
-            wi = np.array([-np.sin(t), 0.0, np.cos(t)])
+            wi = np.array([-np.sin(t) * c, -np.sin(t) * s if s else 0.0, np.cos(t)])
             f = _channel_mean(m.eval(wi, wo), n_points)
             ax_s.semilogy(np.degrees(t_o), np.where(f > 0, f, np.nan), style,
                           color=colours[k % len(colours)], lw=1.2,
                           label=f"{m.name}, $\\theta_i$ = {np.degrees(t):g}°")
-        a = albedo(m, np.radians(_THETA_A_DEG), tol=_ALBEDO_TOL).albedo
+        a = albedo(m, np.radians(_THETA_A_DEG), phi=np.radians(phi_deg),
+                   tol=_ALBEDO_TOL).albedo
         ax_a.plot(_THETA_A_DEG, _channel_mean(a, _THETA_A_DEG.size), style, color="k",
                   label=m.name)
     ax_s.set_xlabel(r"view angle $\theta_o$ in the plane of incidence (degrees; + = mirror side)")
@@ -88,7 +107,9 @@ def model_slices(*models, theta_i_deg=SLICE_THETA_I_DEG, n_points: int = 721):
     ax_a.set_ylim(bottom=0)
     ax_a.grid(alpha=0.3)
     ax_a.legend(fontsize=8)
-    fig.suptitle("in-plane slices and directional albedo: " + ", ".join(m.name for m in models),
-                 fontsize=10)
+    at = ("" if phi_deg == 0.0 and all(m.isotropic for m in models)
+          else f" (plane of incidence at $\\phi_i$ = {phi_deg:g}°)")
+    fig.suptitle("in-plane slices and directional albedo: " + ", ".join(m.name for m in models)
+                 + at, fontsize=10)
     fig.tight_layout()
     return fig

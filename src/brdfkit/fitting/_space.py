@@ -21,7 +21,7 @@ A fit's parameters live in one form, a dict of parameter values (per-channel and
 per-lobe values as arrays); :class:`ParameterSpace` is the one object that reads a
 coordinate from it (:meth:`ParameterSpace.x`), maps coordinates to z and back
 (:meth:`ParameterSpace.z`, :meth:`ParameterSpace.point`) and knows which coordinates are
-free: every declared parameter but choices, optional ones that are None and fixed ones
+free: every declared parameter but choices, bools, optional ones that are None and fixed ones
 (:meth:`ParameterSpace.of_model`), less those a fit holds (gauges of
 ``BRDF.fit_gauge``, inert ones, a scale a pumped model does not see:
 :meth:`ParameterSpace.hold`).
@@ -175,7 +175,7 @@ class ParameterSpace:
         coords = []
         for p in model.params:
             v = values[p.name]
-            if p.kind == "choice" or p.name in fixed or (p.optional and v is None):
+            if p.kind in ("choice", "bool") or p.name in fixed or (p.optional and v is None):
                 continue
             if p.kind == "colour":
                 arr = np.broadcast_to(np.atleast_1d(np.asarray(v, dtype=np.float64)),

@@ -254,11 +254,14 @@ class BRDF:
         return out
 
     def _pack_channel(self, v: dict) -> list[float]:
-        """One channel's kernel argument ``p``; default: declared order, choices as index."""
+        """One channel's kernel argument ``p``; default: declared order, choices as index,
+        bools as 1.0/0.0."""
         row = []
         for p in self.params:
             if v[p.name] is None:
                 row.append(0.0)  # "not given": kernels test for 0 (see Param.optional)
+            elif p.kind == "bool":
+                row.append(1.0 if v[p.name] else 0.0)
             elif p.kind == "choice":
                 row.append(float(p.choices.index(v[p.name])))
             elif p.kind == "lobes":

@@ -61,19 +61,23 @@ class Param:
     ----------
     name : str
         The paper's symbol in ASCII (``rho_d``, ``k_s``, ``n``, ``m`` ...).
-    default : float or str
-        Default value (a string for a choice parameter).
+    default : float, str or bool
+        Default value (a string for a choice parameter, a bool for a bool one).
     lower, upper : float
         Bounds; ``lower_open`` / ``upper_open`` make them strict.
     unit : str
         Unit ("1/sr", "rad", "" for dimensionless).
     doc : str
         One line: what it means and guidance on values.
-    kind : {"scalar", "colour", "lobes", "choice"}
+    kind : {"scalar", "colour", "lobes", "choice", "bool"}
         ``colour``: may be given per channel (a 1-D sequence, RGB or a
         spectrum), broadcasting to a trailing channel axis of the output.
         ``lobes``: may be a 1-D sequence, one value per lobe.
         ``choice``: one of ``choices``.
+        ``bool``: a flag (BRDF Explorer's ``bool NAME DEFAULT``): True/False,
+        1/0 or the words ``true``/``false``/``1``/``0`` (any case; the command
+        line's ``-p isotropic=false``), validated to a Python bool, packed for
+        the kernel as 1.0/0.0; a fit holds it (never fitted).
     choices : tuple of str
         The allowed values of a choice parameter.
     optional : bool
@@ -82,7 +86,7 @@ class Param:
     """
 
     name: str
-    default: float | str
+    default: float | str | bool
     lower: float = -math.inf
     upper: float = math.inf
     unit: str = ""
@@ -97,6 +101,8 @@ class Param:
         """The allowed range as text, e.g. ``[0, 1]`` or ``(0, inf)``."""
         if self.kind == "choice":
             return "one of " + ", ".join(self.choices)
+        if self.kind == "bool":
+            return "true or false"
         lo = "(" if self.lower_open else "["
         hi = ")" if self.upper_open or math.isinf(self.upper) else "]"
         if math.isinf(self.lower):
@@ -104,9 +110,12 @@ class Param:
         return f"{lo}{_fmt(self.lower)}, {_fmt(self.upper)}{hi}"
 
     def validate(self, value, model: str):
-        """Return *value* converted (float, float array, str or None); raise if invalid."""
+        """Return *value* converted (float, float array, str, bool or None); raise if
+        invalid."""
         if value is None and self.optional:
             return None
+        if self.kind == "bool":
+            return self._flag(value, model)
         if type(value) is float and self.kind != "choice" and self._inside(value):
             return value  # the common case (a fit builds a model per evaluation): no array
         if self.kind == "choice":
@@ -137,6 +146,16 @@ class Param:
                 )
         return float(arr) if arr.ndim == 0 else arr.copy()
 
+    def _flag(self, value, model: str) -> bool:
+        if isinstance(value, bool | np.bool_):
+            return bool(value)
+        if isinstance(value, int | float | np.integer | np.floating) and value in (0, 1):
+            return bool(value)
+        if isinstance(value, str) and value.strip().lower() in _FLAG_WORDS:
+            return _FLAG_WORDS[value.strip().lower()]
+        raise ParameterError(f"{model}: parameter {self.name!r} must be true or false "
+                             f"(true/false, 1/0); got {value!r}")
+
     def _inside(self, x: float) -> bool:
         if not math.isfinite(x):
             return False
@@ -150,11 +169,17 @@ class Param:
              "unit": self.unit, "doc": self.doc, "optional": self.optional}
         if self.kind == "choice":
             d["choices"] = list(self.choices)
+        elif self.kind == "bool":
+            d["bounds"] = self.bounds_text()
         else:
             d["lower"] = None if math.isinf(self.lower) else self.lower
             d["upper"] = None if math.isinf(self.upper) else self.upper
             d["bounds"] = self.bounds_text()
         return d
+
+
+#: The words a bool parameter accepts (any case), and what they mean.
+_FLAG_WORDS = {"true": True, "false": False, "1": True, "0": False}
 
 
 def _fmt(x: float) -> str:

@@ -26,6 +26,15 @@ sampler stay single ``Float`` computations); a column that varies becomes
   wavefront route interpolates f_r itself: both are linear interpolation
   between grid points, exact at them; they differ by O(h²) terms.
 
+A kernel that computes every channel and keeps its row's by a channel index in the
+row (a user model's: ``select(p[K-1] == 0.0, r, select(p[K-1] == 1.0, g, b))``, the
+form of :mod:`brdfkit.user`'s kernels) works unchanged: the index column is the
+``Color3f`` (0, 1, 2), its comparisons are 3-channel masks, and the selected f_r a
+3-channel array (an ``Array3f``, which mono variants reduce to luminance as a
+``Color3f``). In spectral variants such a model takes the wavefront route (RGB
+channels); on a wavelength grid its index column would be interpolated, so give such
+a model RGB channels only.
+
 References
 ----------
 - W. Jakob et al., *Mitsuba 3 renderer*, 2022 (``BSDF`` interface, "Custom
@@ -106,7 +115,9 @@ def traced_class(mi, dr, variant: str) -> type:
 
         def _spectrum(self, f):
             """f_r (Float, Color3f or Spectrum) as this variant's Spectrum."""
-            if kind == "mono" and isinstance(f, mi.Color3f):
+            # three channels: a Color3f, or the Array3f that a select over a Color3f
+            # column's comparison makes (a kernel choosing its channel by an index column)
+            if kind == "mono" and dr.size_v(f) == 3:
                 return mi.Spectrum(mi.luminance(f))
             return mi.Spectrum(f)
 
