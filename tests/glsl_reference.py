@@ -31,7 +31,8 @@ Public objects
 - :class:`Parameter`, :class:`BrdfSource`, :func:`read_brdf` — a ``.brdf`` file's parts.
 - :func:`unavailable_reason` — why there is no Mesa context (None when there is one).
 - :func:`compute_source` — the compute shader built from a file.
-- :class:`GlslBRDF` — a compiled file: ``GlslBRDF(path)(wi, wo, **params)`` → float32 (N, 3).
+- :class:`GlslBRDF` — a compiled file: ``GlslBRDF(path)(wi, wo, **params)`` → float32 (N, 3);
+  ``.sample(u, **params)`` runs its isFunc ``sampleBRDF`` (value, wi, pdf).
 - :func:`mesa_errors` — Mesa's compile errors for a file, as (line, column, message).
 - :func:`require_mesa` — the context, or a pytest skip with the reason (the body of the
   test modules' ``mesa`` fixture).
@@ -84,7 +85,8 @@ class Parameter:
 class BrdfSource:
     """A ``.brdf`` file's parts: its parameters (file order), shader and isFunc text.
 
-    ``shader_line`` is the 1-based line of the file where the shader text starts.
+    ``shader_line`` (``is_func_line``) is the 1-based line of the file where the shader
+    (isFunc) text starts; ``is_func`` is "" when the file has no isFunc section.
     """
 
     path: Path
@@ -92,6 +94,7 @@ class BrdfSource:
     shader: str
     shader_line: int
     is_func: str = ""
+    is_func_line: int = 0
 
     def param(self, name: str) -> Parameter:
         for p in self.params:
@@ -162,8 +165,10 @@ def read_brdf(path) -> BrdfSource:
         raise ValueError(f"{path}: section {current!r} is not closed")
     if "shader" not in sections:
         raise ValueError(f"{path}: no '::begin shader' section")
+    is_func = "\n".join(sections.get("isFunc", []))
     return BrdfSource(path, tuple(params), "\n".join(sections["shader"]) + "\n",
-                      starts["shader"], "\n".join(sections.get("isFunc", [])))
+                      starts["shader"], is_func + "\n" if is_func.strip() else "",
+                      starts.get("isFunc", 0))
 
 
 # --------------------------------------------------------------------------- the context
@@ -207,8 +212,18 @@ def renderer() -> str:
 
 
 # --------------------------------------------------------------------------- the shader
-def compute_source(source: BrdfSource) -> str:
-    """The compute shader: version, buffers, the uniforms, the shader, then main()."""
+#: BRDF Explorer's importance-sampling function (BRDFBase::getISFunction's signature)
+IS_FUNC_CALL = "sampleBRDF(u, v, N, X, Y, wi, pdf)"
+
+
+def compute_source(source: BrdfSource, *, sample: bool = False) -> str:
+    """The compute shader: version, buffers, the uniforms, the shader, then main().
+
+    The isFunc section, if any, follows the shader (as BRDF Explorer inserts it). With
+    *sample*, main() calls ``vec3 sampleBRDF(float u, float v, vec3 N, vec3 X, vec3 Y,
+    out vec3 wi, out float pdf)`` instead of BRDF, reading (u, v) from the pairs' first
+    two components and writing (value, wi, pdf) as two vec4.
+    """
     head = [
         "#version 430",
         f"layout(local_size_x = {LOCAL_SIZE}) in;",
@@ -221,7 +236,25 @@ def compute_source(source: BrdfSource) -> str:
     # exactly as BRDF Explorer's loadShaderFromFile: floats, then bools, then colours
     for kind, glsl in (("float", "float"), ("bool", "bool"), ("color", "vec3")):
         head += [f"uniform {glsl} {p.name};" for p in source.params if p.kind == kind]
-    main = (
+    if sample:
+        main = (
+            "void main() {\n"
+            "    uint i = gl_GlobalInvocationID.x;\n"
+            f"    if (i >= {_PREFIX}n) return;\n"
+            f"    float u = {_PREFIX}dirs[2u * i].x;\n"
+            f"    float v = {_PREFIX}dirs[2u * i].y;\n"
+            "    vec3 N = vec3(0.0, 0.0, 1.0);\n"
+            "    vec3 X = vec3(1.0, 0.0, 0.0);\n"
+            "    vec3 Y = vec3(0.0, 1.0, 0.0);\n"
+            "    vec3 wi;\n"
+            "    float pdf;\n"
+            f"    vec3 value = {IS_FUNC_CALL};\n"
+            f"    {_PREFIX}out[2u * i] = vec4(value, 0.0);\n"
+            f"    {_PREFIX}out[2u * i + 1u] = vec4(wi, pdf);\n"
+            "}\n")
+    else:
+        main = None
+    main = main or (
         "void main() {\n"
         "    uint i = gl_GlobalInvocationID.x;\n"
         f"    if (i >= {_PREFIX}n) return;\n"
@@ -233,8 +266,9 @@ def compute_source(source: BrdfSource) -> str:
         f"    {_PREFIX}out[i] = vec4(BRDF(L, V, N, X, Y), 0.0);\n"
         "}\n")
     # '#line n': the next line is line n, so Mesa's messages name the .brdf file's lines
+    is_func = f"#line {source.is_func_line}\n{source.is_func}" if source.is_func else ""
     return "\n".join(head) + f"\n#line {source.shader_line}\n" + source.shader + \
-        "#line 100000\n" + main
+        is_func + "#line 100000\n" + main
 
 
 _ERROR = re.compile(r"^\d+:(\d+)\((\d+)\): error: (.*)$", re.MULTILINE)
@@ -275,11 +309,31 @@ class GlslBRDF:
         self.path = self.source.path
         self._ctx = require_mesa()
         self._program = self._ctx.compute_shader(compute_source(self.source))
+        self._sampler = None  # the isFunc program, compiled on first use
 
     def __call__(self, wi, wo, **params) -> np.ndarray:
         wi, wo = _as_rows(wi, "wi"), _as_rows(wo, "wo")
         if wi.shape != wo.shape:
             raise ValueError(f"wi and wo must have the same shape; got {wi.shape}, {wo.shape}")
+        return self._run(self._program, wi, wo, 1, params)[:, 0, :3].copy()
+
+    def sample(self, u, **params):
+        """The file's isFunc ``sampleBRDF`` at *u* (N, 2) in [0, 1)²: (value (N, 3), wi
+        (N, 3), pdf (N,)), float32. ValueError when the file has no isFunc section."""
+        if not self.source.is_func:
+            raise ValueError(f"{self.path.name} has no isFunc section")
+        if self._sampler is None:
+            self._sampler = self._ctx.compute_shader(compute_source(self.source, sample=True))
+        u = np.asarray(u, dtype=np.float64)
+        if u.ndim != 2 or u.shape[1] != 2:
+            raise ValueError(f"u must have shape (N, 2); got {u.shape}")
+        rows = np.zeros((u.shape[0], 3))
+        rows[:, :2] = u
+        out = self._run(self._sampler, rows, rows, 2, params)
+        return out[:, 0, :3].copy(), out[:, 1, :3].copy(), out[:, 1, 3].copy()
+
+    def _run(self, program, wi, wo, n_out: int, params: dict) -> np.ndarray:
+        """Set the uniforms, run *program* over the pairs: float32 (N, n_out, 4)."""
         names = {p.name for p in self.source.params}
         unknown = set(params) - names
         if unknown:
@@ -287,7 +341,7 @@ class GlslBRDF:
                            f"valid: {sorted(names)}")
         for p in self.source.params:
             value = params.get(p.name, p.default)
-            uniform = self._program.get(p.name, None)  # None: optimised away (unused)
+            uniform = program.get(p.name, None)  # None: optimised away (unused)
             if uniform is None:
                 continue
             if p.kind == "color":
@@ -300,19 +354,17 @@ class GlslBRDF:
         dirs = np.zeros((n, 2, 4), dtype=np.float32)
         dirs[:, 0, :3] = wi
         dirs[:, 1, :3] = wo
-        out = np.zeros((max(n, 1), 4), dtype=np.float32)
         inp = self._ctx.buffer(dirs.tobytes() if n else bytes(32))
-        res = self._ctx.buffer(out.tobytes())
+        res = self._ctx.buffer(reserve=max(n, 1) * n_out * 16)
         try:
             inp.bind_to_storage_buffer(0)
             res.bind_to_storage_buffer(1)
-            self._program[f"{_PREFIX}n"].value = n
-            self._program.run(group_x=max(1, -(-n // LOCAL_SIZE)))
-            values = np.frombuffer(res.read(), dtype=np.float32).reshape(-1, 4)[:n, :3]
+            program[f"{_PREFIX}n"].value = n
+            program.run(group_x=max(1, -(-n // LOCAL_SIZE)))
+            return np.frombuffer(res.read(), dtype=np.float32).reshape(-1, n_out, 4)[:n]
         finally:
             inp.release()
             res.release()
-        return values.copy()
 
 
 # --------------------------------------------------------------------------- test helpers

@@ -151,12 +151,17 @@ def albedo_cmd(model, param, pump, times, theta, phi, tol, as_json, as_csv, plot
     with_phi = not m.isotropic or phi_deg != 0.0
     if plot:
         _plot_albedo(th, a, m.name, plot, phi_deg if with_phi else None)
+    # an angle that did not converge (e.g. NaN in the integrand) says so: the result's
+    # status and message, present only then (the output of converged runs is unchanged)
+    unconverged = {k: v for k, v in r.to_dict().items() if k in ("status", "message")}
     if as_json:
         emit_json({"model": d["model"], "params": d["params"],
                    **({"pump": d["pump"]} if "pump" in d else {}),
                    "theta_deg": th, **({"phi_deg": phi_deg} if with_phi else {}),
-                   "albedo": a, "error": e})
+                   "albedo": a, "error": e, **unconverged})
         return
+    if unconverged:
+        click.echo(f"brdfkit: warning: {unconverged['message']}", err=True)
     coloured = a.ndim == 2
     if as_csv:
         if coloured:
