@@ -85,7 +85,7 @@ def child(path: Path, cache: str) -> dict:
 
 def compile_rows(repeats: int) -> list:
     rows = []
-    for r in range(repeats):
+    for _r in range(repeats):
         with tempfile.TemporaryDirectory(prefix="brdfkit-bench-") as cache:
             first = child(PRINCIPLED, cache)
             again = child(PRINCIPLED, cache)

@@ -106,10 +106,14 @@ class _Place:
 
 
 def _language():
+    import warnings
+
     import tree_sitter
     import tree_sitter_glsl
 
-    return tree_sitter.Language(tree_sitter_glsl.language())
+    with warnings.catch_warnings():  # tree-sitter-glsl 0.2 hands over its grammar as an int
+        warnings.simplefilter("ignore", DeprecationWarning)
+        return tree_sitter.Language(tree_sitter_glsl.language())
 
 
 def parse(text: str, *, path: str = "<shader>", first_line: int = 0):

@@ -138,7 +138,7 @@ def _mix_impl(args):
         if a.n not in (1, x.n):
             raise V.TypeProblem(f"mix: a {a.type} selector for {x.type}")
         comps = tuple(D.op("select", c, yy, xx) for c, xx, yy in zip(
-            a.comps * (x.n if a.n == 1 else 1), x.comps, y.comps))
+            a.comps * (x.n if a.n == 1 else 1), x.comps, y.comps, strict=False))
         tags = x.tags & y.tags if a.tags & (V.EVEN | V.SCALARS) else V.NONE
         return V.Val("float", comps, tags, x.why or y.why or a.why)
     return _ternary("mix", _mix)(args)

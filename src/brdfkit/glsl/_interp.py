@@ -16,12 +16,11 @@ nodes (:mod:`._dag`), so the result is the BRDF as one expression per colour cha
 - **Functions are inlined**: a call runs the callee's body on the argument values, in
   its own scopes (globals visible; writing a global is refused). A user function hides
   every built-in of its name, as GLSL ≥ 1.30 scopes them and Mesa compiles them (a file's
-  own ``reflect`` with the opposite sign is the one called); overloads are chosen by exact argument types,
-  then with int → float conversion. A function is visible from its first declaration
+  own ``reflect`` with the opposite sign is the one called); overloads are chosen by
+  exact argument types, then with int → float conversion. A function is visible from its first declaration
   (prototype or definition) on: a call above it reaches the built-in. Recursion is
   refused.
-- Declarations: ``const`` and other globals, ``#define NAME VALUE`` (an object-like
-  macro naming a constant expression), locals in block scopes, several declarators per
+- Declarations: ``const`` and other globals, locals in block scopes, several declarators per
   line; uninitialised locals are 0.
 
 Refused, with the file, line, column and construct: textures and samplers, arrays,
@@ -44,34 +43,14 @@ from dataclasses import dataclass, field
 from brdfkit.glsl import _dag as D
 from brdfkit.glsl import _values as V
 from brdfkit.glsl._builtins import BUILTINS
+from brdfkit.glsl._expressions import Expressions
+from brdfkit.glsl._syntax import UNSUPPORTED_CALLS, UNSUPPORTED_NODES, Failure, named, text
 
 __all__ = ["run", "Failure", "MAX_ITERATIONS"]
 
 #: The most iterations one loop is unrolled to (a shader's loops over lobes or samples have
 #: tens; more is a sign of a bound that only looks constant, and of a huge kernel).
 MAX_ITERATIONS = 1024
-
-_UNSUPPORTED_CALLS = ("texture", "texelFetch", "textureLod", "texture2D", "textureCube",
-                      "dFdx", "dFdy", "fwidth", "noise1", "noise2", "noise3")
-_UNSUPPORTED_NODES = {
-    "switch_statement": "a switch statement", "goto_statement": "goto",
-    "struct_specifier": "a struct", "array_declarator": "an array",
-    "preproc_function_def": "a function-like macro", "preproc_if": "#if",
-    "preproc_ifdef": "#ifdef", "preproc_call": "a preprocessor directive",
-    "preproc_include": "#include", "pointer_expression": "a pointer",
-    "cast_expression": "a C cast", "sizeof_expression": "sizeof",
-    "compound_literal_expression": "a compound literal",
-}
-
-
-class Failure(Exception):
-    """A problem at (row, column) of the shader (0-based), with its message."""
-
-    def __init__(self, node, message: str):
-        super().__init__(message)
-        self.row, self.col = (node.start_point[0], node.start_point[1]) if node else (0, 0)
-        self.message = message
-
 
 @dataclass
 class _Var:
@@ -108,18 +87,10 @@ class _Frame:
     ret: V.Val | None = None
 
 
-def _text(node) -> str:
-    return node.text.decode("utf-8", "replace")
-
-
-def _named(node):
-    return [c for c in node.named_children if c.type != "comment"]
-
-
 def _type_of(node) -> tuple[str, int] | None:
     if node.type not in ("primitive_type", "type_identifier"):
         return None
-    name = _text(node)
+    name = text(node)
     if name == "void":
         return None
     parsed = V.parse_type(name)
@@ -131,7 +102,7 @@ def _type_of(node) -> tuple[str, int] | None:
     return parsed
 
 
-class _Interpreter:
+class _Interpreter(Expressions):
     def __init__(self, root, uniforms: dict):
         self.root = root
         self.globals: dict[str, _Var] = {k: _Var(v, const=True, is_global=True)
@@ -144,23 +115,23 @@ class _Interpreter:
 
     # ------------------------------------------------------------ top level
     def collect(self):
-        for node in _named(self.root):
+        for node in named(self.root):
             if node.type == "function_definition":
                 self._define(node)
             elif node.type == "declaration":
-                for d in _named(node):
+                for d in named(node):
                     if d.type == "function_declarator":  # a prototype: declared from here
-                        fname = _text(d.child_by_field_name("declarator"))
+                        fname = text(d.child_by_field_name("declarator"))
                         self.declared_at.setdefault(fname, node.start_byte)
-        for node in _named(self.root):
+        for node in named(self.root):
             if node.type == "function_definition":
                 continue
             if node.type == "declaration":
                 self._declare(node, global_scope=True)
             elif node.type == "preproc_def":
                 self._define_macro(node)
-            elif node.type in _UNSUPPORTED_NODES:
-                raise Failure(node, f"{_UNSUPPORTED_NODES[node.type]} is not supported")
+            elif node.type in UNSUPPORTED_NODES:
+                raise Failure(node, f"{UNSUPPORTED_NODES[node.type]} is not supported")
             elif node.type != ";":
                 raise Failure(node, f"unexpected {node.type.replace('_', ' ')} at file scope")
 
@@ -168,16 +139,16 @@ class _Interpreter:
         decl = node.child_by_field_name("declarator")
         if decl is None or decl.type != "function_declarator":
             raise Failure(node, "a function definition without a name and parameters")
-        name = _text(decl.child_by_field_name("declarator"))
+        name = text(decl.child_by_field_name("declarator"))
         ret_node = node.child_by_field_name("type")
         ret = _type_of(ret_node)
         params = []
-        for p in _named(decl.child_by_field_name("parameters")):
+        for p in named(decl.child_by_field_name("parameters")):
             if p.type != "parameter_declaration":
                 raise Failure(p, f"unexpected {p.type} in a parameter list")
             quals = [c for c in p.children if c.type in ("out", "inout")]
             if quals:
-                raise Failure(quals[0], f"{_text(quals[0])} parameters are not supported "
+                raise Failure(quals[0], f"{text(quals[0])} parameters are not supported "
                                         "(outside isFunc); return the value instead")
             ptype = _type_of(p.child_by_field_name("type"))
             pname = p.child_by_field_name("declarator")
@@ -187,7 +158,7 @@ class _Interpreter:
                 raise Failure(p, "a parameter of type void")
             if pname is None or pname.type != "identifier":
                 raise Failure(p, "a parameter must be a plain name (arrays are not supported)")
-            params.append((_text(pname), ptype[0], ptype[1], p))
+            params.append((text(pname), ptype[0], ptype[1], p))
         fn = _Function(node, name, params, ret)
         self.declared_at[name] = min(self.declared_at.get(name, node.start_byte),
                                      node.start_byte)
@@ -198,12 +169,12 @@ class _Interpreter:
         self.functions.setdefault(name, []).append(fn)
 
     def _define_macro(self, node):
-        name = _text(node.child_by_field_name("name"))
+        name = text(node.child_by_field_name("name"))
         value = node.child_by_field_name("value")
         if value is None:
             raise Failure(node, f"#define {name} without a value is not supported")
         raise Failure(node, f"#define is not supported (write 'const float {name} = "
-                            f"{_text(value).strip()};')")
+                            f"{text(value).strip()};')")
 
     def brdf(self, inputs):
         fns = self.functions.get("BRDF", [])
@@ -221,7 +192,7 @@ class _Interpreter:
         if len(self.frames) > 64:
             raise Failure(where, "function calls nested more than 64 deep")
         scope = {}
-        for (pname, base, n, _), a in zip(fn.params, args):
+        for (pname, base, _n, _), a in zip(fn.params, args, strict=False):
             scope[pname] = _Var(V.convert(a, base))
         frame = _Frame(fn, [scope])
         self.frames.append(frame)
@@ -235,7 +206,7 @@ class _Interpreter:
             raise Failure(fn.node, f"function {fn.name!r} does not return a value")
         return frame.ret
 
-    def call_named(self, name: str, args: list, node) -> V.Val:
+    def callnamed(self, name: str, args: list, node) -> V.Val:
         # GLSL (as Mesa implements it): a user function is visible from its first
         # declaration on, and from there hides every built-in of its name
         if name in self.functions:
@@ -255,7 +226,7 @@ class _Interpreter:
                 return BUILTINS[name](args)
             except V.TypeProblem as e:
                 raise Failure(node, str(e)) from None
-        if name.startswith(("texture", "sampler")) or name in _UNSUPPORTED_CALLS:
+        if name.startswith(("texture", "sampler")) or name in UNSUPPORTED_CALLS:
             raise Failure(node, f"{name}() is not supported (textures and derivatives)")
         if name.startswith(("mat", "dmat")):
             raise Failure(node, f"{name}() is not supported (matrices)")
@@ -270,7 +241,7 @@ class _Interpreter:
         for f in cands:
             if len(f.params) == len(args) and all(
                     (b, n) == t or (b == "float" and t == ("int", n))
-                    for (_, b, n, _), t in zip(f.params, types)):
+                    for (_, b, n, _), t in zip(f.params, types, strict=False)):
                 return f
         got = ", ".join(V.type_of(*t) for t in types)
         raise Failure(node, f"no function {name}({got}) (defined: " + "; ".join(
@@ -332,7 +303,7 @@ class _Interpreter:
     def block(self, node):
         self.frame.scopes.append({})
         try:
-            for child in _named(node):
+            for child in named(node):
                 self.statement(child)
         finally:
             self.frame.scopes.pop()
@@ -344,8 +315,8 @@ class _Interpreter:
         if t == "declaration":
             return self._declare(node, global_scope=False)
         if t == "expression_statement":
-            kids = _named(node)
-            if kids and kids[0].type == "identifier" and _text(kids[0]) == "discard":
+            kids = named(node)
+            if kids and kids[0].type == "identifier" and text(kids[0]) == "discard":
                 raise Failure(kids[0], "discard is not supported")
             for k in kids:
                 self.expr(k)
@@ -365,12 +336,12 @@ class _Interpreter:
             else:
                 lp.iter_alive = V.binary("&&", lp.iter_alive, V.unary("!", g))
             return None
-        if t in _UNSUPPORTED_NODES:
-            raise Failure(node, f"{_UNSUPPORTED_NODES[t]} is not supported")
+        if t in UNSUPPORTED_NODES:
+            raise Failure(node, f"{UNSUPPORTED_NODES[t]} is not supported")
         raise Failure(node, f"{t.replace('_', ' ')} is not supported")
 
     def _declare(self, node, *, global_scope: bool):
-        quals = [_text(c) for c in node.children if c.type in ("type_qualifier", "uniform",
+        quals = [text(c) for c in node.children if c.type in ("type_qualifier", "uniform",
                                                                 "in", "out", "attribute",
                                                                 "varying", "buffer")]
         for q in quals:
@@ -392,9 +363,9 @@ class _Interpreter:
                 value_node = d.child_by_field_name("value")
                 d = d.child_by_field_name("declarator")
             if d.type != "identifier":
-                what = _UNSUPPORTED_NODES.get(d.type, d.type.replace("_", " "))
+                what = UNSUPPORTED_NODES.get(d.type, d.type.replace("_", " "))
                 raise Failure(d, f"{what} is not supported")
-            name = _text(d)
+            name = text(d)
             if value_node is not None:
                 val = self._coerce(self.expr(value_node), vtype[0], vtype[1], value_node,
                                    f"the initial value of {name!r}")
@@ -414,7 +385,7 @@ class _Interpreter:
         then, alt = node.child_by_field_name("consequence"), node.child_by_field_name(
             "alternative")
         if alt is not None and alt.type == "else_clause":
-            alt = _named(alt)[0]
+            alt = named(alt)[0]
         c = cond.comps[0]
         if c.is_const:
             branch = then if D.value_of(c) else alt
@@ -441,7 +412,7 @@ class _Interpreter:
                 self.frame.scopes.pop()
 
     def _condition(self, node) -> V.Val:
-        kids = _named(node) if node.type == "parenthesized_expression" else [node]
+        kids = named(node) if node.type == "parenthesized_expression" else [node]
         v = self.expr(kids[-1]) if kids else None
         if v is None or v.type != "bool":
             raise Failure(node, f"a condition must be a bool; found {v.type if v else 'nothing'}")
@@ -449,7 +420,7 @@ class _Interpreter:
 
     def _return(self, node):
         f = self.frame
-        kids = _named(node)
+        kids = named(node)
         if f.function.ret is None:
             if kids:
                 raise Failure(node, f"the void function {f.function.name!r} returns a value")
@@ -508,148 +479,6 @@ class _Interpreter:
             f.scopes.pop()
 
     # ------------------------------------------------------------ expressions
-    def expr(self, node) -> V.Val:
-        """The value of the expression *node*; a frame-dependence reason that has no place
-        yet gets this expression's (``why @row:col``)."""
-        v = self._expr(node)
-        if v.why and " @" not in v.why:
-            v = V.Val(v.base, v.comps, v.tags, f"{v.why} @{node.start_point[0]}:"
-                                               f"{node.start_point[1]}")
-        return v
-
-    def _expr(self, node) -> V.Val:  # noqa: C901 - one dispatch over the expression kinds
-        t = node.type
-        try:
-            if t == "number_literal":
-                return _number(node)
-            if t in ("true", "false"):
-                return V.scalar(D.const(t == "true"), "bool")
-            if t == "identifier":
-                return self.lookup(_text(node), node).val
-            if t == "parenthesized_expression":
-                kids = _named(node)
-                return self.expr(kids[-1])
-            if t == "comma_expression":
-                kids = _named(node)
-                for k in kids[:-1]:
-                    self.expr(k)
-                return self.expr(kids[-1])
-            if t == "binary_expression":
-                op = _text(node.child_by_field_name("operator"))
-                a = self.expr(node.child_by_field_name("left"))
-                b = self.expr(node.child_by_field_name("right"))
-                if op in ("&", "|", "^", "<<", ">>", "%"):
-                    raise Failure(node, f"the operator {op!r} is not supported")
-                return V.binary(op, a, b)
-            if t == "unary_expression":
-                op = _text(node.child_by_field_name("operator"))
-                if op == "~":
-                    raise Failure(node, "the operator '~' is not supported")
-                return V.unary(op, self.expr(node.child_by_field_name("argument")))
-            if t == "conditional_expression":
-                c = self._condition(node.child_by_field_name("condition"))
-                a = self.expr(node.child_by_field_name("consequence"))
-                b = self.expr(node.child_by_field_name("alternative"))
-                return V.select(c, a, b)
-            if t == "call_expression":
-                fn = node.child_by_field_name("function")
-                if fn.type not in ("identifier", "type_identifier", "primitive_type"):
-                    raise Failure(fn, f"a call of {fn.type.replace('_', ' ')} is not supported")
-                name = _text(fn)
-                if name not in self.functions and (name.startswith(("texture", "sampler"))
-                                                   or name in _UNSUPPORTED_CALLS):
-                    raise Failure(node, f"{name}() is not supported (textures and derivatives)")
-                args = [self.expr(a) for a in _named(node.child_by_field_name("arguments"))]
-                return self.call_named(name, args, node)
-            if t == "field_expression":
-                v = self.expr(node.child_by_field_name("argument"))
-                fld = _text(node.child_by_field_name("field"))
-                if fld == "length":
-                    raise Failure(node, ".length() of arrays is not supported")
-                return V.component(v, V.component_indices(fld, v.n), f"the component .{fld}")
-            if t == "subscript_expression":
-                v = self.expr(node.child_by_field_name("argument"))
-                k = self._index(node.child_by_field_name("index"), v)
-                return V.component(v, (k,), f"the component [{k}]")
-            if t == "assignment_expression":
-                return self._assignment(node)
-            if t == "update_expression":
-                return self._update(node)
-        except V.TypeProblem as e:
-            raise Failure(node, str(e)) from None
-        if t in _UNSUPPORTED_NODES:
-            raise Failure(node, f"{_UNSUPPORTED_NODES[t]} is not supported")
-        raise Failure(node, f"{t.replace('_', ' ')} is not supported")
-
-    def _index(self, node, v: V.Val) -> int:
-        k = self.expr(node)
-        c = k.comps[0] if k.is_scalar else None
-        if c is None or not c.is_const or k.base != "int":
-            raise Failure(node, "an index must be a constant int (arrays are not supported)")
-        i = int(D.value_of(c))
-        if not 0 <= i < v.n:
-            raise Failure(node, f"index {i} out of range for {v.type}")
-        return i
-
-    def _target(self, node):
-        """(variable, name, component indices or None) of an assignment's left side."""
-        if node.type == "identifier":
-            name = _text(node)
-            return self.lookup(name, node), name, None
-        if node.type == "parenthesized_expression":
-            return self._target(_named(node)[-1])
-        if node.type in ("field_expression", "subscript_expression"):
-            var, name, idx = self._target(node.child_by_field_name("argument"))
-            n = var.val.n if idx is None else len(idx)
-            if node.type == "field_expression":
-                sel = V.component_indices(_text(node.child_by_field_name("field")), n)
-                if len(set(sel)) != len(sel):
-                    raise Failure(node, "a swizzle written to repeats a component")
-            else:
-                sel = (self._index(node.child_by_field_name("index"),
-                                   V.Val(var.val.base, (None,) * n)),)
-            base_idx = tuple(range(var.val.n)) if idx is None else idx
-            return var, name, tuple(base_idx[i] for i in sel)
-        raise Failure(node, f"cannot assign to {node.type.replace('_', ' ')}")
-
-    def _write(self, var, name, idx, new: V.Val, node) -> V.Val:
-        if idx is None:
-            return self.assign(var, new, node, name)
-        old = var.val
-        new = self._coerce(new, old.base, len(idx), node, f"assignment to {name!r}")
-        comps = list(old.comps)
-        for i, c in zip(idx, new.comps):
-            comps[i] = c
-        tags = old.tags & (V.SCALARS if "even" in new.tags or "scalars" in new.tags else V.NONE)
-        whole = V.Val(old.base, tuple(comps), tags, old.why or new.why or (
-            None if tags else "a write to single components of a vector"))
-        return self.assign(var, whole, node, name)
-
-    def _read(self, var, idx) -> V.Val:
-        return var.val if idx is None else V.component(var.val, idx, "a component")
-
-    def _assignment(self, node):
-        op = _text(node.child_by_field_name("operator"))
-        var, name, idx = self._target(node.child_by_field_name("left"))
-        rhs = self.expr(node.child_by_field_name("right"))
-        if op != "=":
-            sym = op[:-1]
-            if sym not in ("+", "-", "*", "/"):
-                raise Failure(node, f"the operator {op!r} is not supported")
-            rhs = V.binary(sym, self._read(var, idx), rhs)
-        return self._write(var, name, idx, rhs, node)
-
-    def _update(self, node):
-        op = _text(node.child_by_field_name("operator"))
-        arg = node.child_by_field_name("argument")
-        var, name, idx = self._target(arg)
-        old = self._read(var, idx)
-        new = V.binary("+" if op == "++" else "-", old, V.scalar(D.const(1.0), "int"))
-        self._write(var, name, idx, new, node)
-        postfix = node.children[0].id == arg.id
-        return old if postfix else new
-
-
 def _guarded(g: V.Val, new: V.Val, old: V.Val) -> V.Val:
     """*new* where the guard *g* holds, else *old* (the value of an assignment or a return
     under conditions)."""
@@ -657,23 +486,6 @@ def _guarded(g: V.Val, new: V.Val, old: V.Val) -> V.Val:
     if c.is_const:
         return new if D.value_of(c) else old
     return V.select(g, new, old)
-
-
-def _number(node) -> V.Val:
-    text = _text(node).strip()
-    low = text.lower()
-    try:
-        if low.startswith("0x"):
-            return V.scalar(D.const(int(low.rstrip("u"), 16)), "int")
-        if low.endswith("lf"):
-            return V.scalar(D.const(float(low[:-2])), "float")
-        if "." in low or "e" in low or low.endswith("f"):
-            return V.scalar(D.const(float(low.rstrip("f"))), "float")
-        if len(low) > 1 and low.startswith("0") and low.rstrip("u").isdigit():
-            return V.scalar(D.const(int(low.rstrip("u"), 8)), "int")
-        return V.scalar(D.const(int(low.rstrip("u"))), "int")
-    except ValueError:
-        raise Failure(node, f"malformed number {text!r}") from None
 
 
 def run(root, *, uniforms: dict, inputs: list) -> V.Val:

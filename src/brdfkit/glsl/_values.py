@@ -209,7 +209,7 @@ def binary(symbol: str, a: Val, b: Val) -> Val:
         if a.type != b.type:
             raise TypeProblem(f"{symbol} needs operands of one type; got {a.type}, {b.type}")
         out = D.const(True)
-        for x, y in zip(a.comps, b.comps):
+        for x, y in zip(a.comps, b.comps, strict=False):
             out = D.op("and", out, D.op("eq", x, y))
         if name == "ne":
             out = D.op("not", out)
@@ -219,13 +219,13 @@ def binary(symbol: str, a: Val, b: Val) -> Val:
     if name in ("add", "sub"):
         tags = a.tags & b.tags if a.n == b.n else (
             SCALARS if "even" in (a.tags | b.tags) and "scalars" in (a.tags | b.tags) else NONE)
-        comps = tuple(D.op(name, x, y) for x, y in zip(ca, cb))
+        comps = tuple(D.op(name, x, y) for x, y in zip(ca, cb, strict=False))
     else:
         tags = _mul_tags(a, b) if name == "mul" else _div_tags(a, b)
         if name == "div" and a.base == "int":  # integer division truncates toward 0
-            comps = tuple(_trunc(D.op("div", x, y)) for x, y in zip(ca, cb))
+            comps = tuple(_trunc(D.op("div", x, y)) for x, y in zip(ca, cb, strict=False))
         else:
-            comps = tuple(D.op(name, x, y) for x, y in zip(ca, cb))
+            comps = tuple(D.op(name, x, y) for x, y in zip(ca, cb, strict=False))
     why = None if tags else _why(a, b, reason=f"a component-wise {symbol} of directions")
     return Val(a.base, comps, tags, why)
 
@@ -263,7 +263,7 @@ def select(c: Val, a: Val, b: Val) -> Val:
         else:
             raise TypeProblem(f"both sides of ?: must have one type; got {a.type} and {b.type}")
     tags = a.tags & b.tags if "even" in c.tags else NONE
-    comps = tuple(D.op("select", c.comps[0], x, y) for x, y in zip(a.comps, b.comps))
+    comps = tuple(D.op("select", c.comps[0], x, y) for x, y in zip(a.comps, b.comps, strict=False))
     why = None if tags else _why(c, a, b, reason="a choice made on a frame-dependent value")
     return Val(a.base, comps, tags, why)
 
@@ -282,7 +282,7 @@ def apply(name: str, fn, *args: Val) -> Val:
         if a.n not in (1, n):
             raise TypeProblem(f"{name}: arguments of sizes {', '.join(x.type for x in args)}")
         cols.append(a.comps * n if a.n == 1 else a.comps)
-    comps = tuple(fn(*xs) for xs in zip(*cols))
+    comps = tuple(fn(*xs) for xs in zip(*cols, strict=False))
     if n == 1:
         if all("even" in a.tags for a in args):
             tags = EVEN
@@ -305,7 +305,7 @@ def dot(a: Val, b: Val) -> Val:
         raise TypeProblem(f"dot of {a.type} and {b.type}")
     a, b = _promote(a, b)
     out = None
-    for x, y in zip(a.comps, b.comps):
+    for x, y in zip(a.comps, b.comps, strict=False):
         term = D.op("mul", x, y)
         out = term if out is None else D.op("add", out, term)
     tags = set()

@@ -141,9 +141,10 @@ def _parameter(path, line, raw: str) -> FileParam:
                                              f"false); found {tokens[2]!r}")
         return FileParam("bool", name, word in ("1", "true"), line=line)
     nums = [_number(path, line, c, t, f"{kind} {name}: {w}") for t, c, w in zip(
-        tokens[2:5], cols[2:5], ("MIN", "MAX", "DEFAULT") if kind == "float" else "RGB")]
+        tokens[2:5], cols[2:5], ("MIN", "MAX", "DEFAULT") if kind == "float" else "RGB",
+        strict=False)]
     if kind == "color":
-        bad = [(x, c) for x, c in zip(nums, cols[2:5]) if x < 0.0]
+        bad = [(x, c) for x, c in zip(nums, cols[2:5], strict=False) if x < 0.0]
         if bad:
             raise _fail(path, line, bad[0][1], f"color {name}: components must be >= 0; found "
                                                f"{bad[0][0]:g}")
@@ -224,8 +225,9 @@ def read_brdf_file(path) -> BrdfFile:
         if section == "parameters":
             p = _parameter(path, i, raw)
             if p.name in seen:
-                raise _fail(path, i, raw.index(p.name) + 1, f"parameter {p.name!r} is declared "
-                                                             f"twice (first on line {seen[p.name]})")
+                first = seen[p.name]
+                raise _fail(path, i, raw.index(p.name) + 1,
+                            f"parameter {p.name!r} is declared twice (first on line {first})")
             seen[p.name] = i
             params.append(p)
         elif section == "shader":
@@ -276,7 +278,6 @@ def _declarations(f: BrdfFile) -> tuple:
 
 def _layout(f: BrdfFile):
     """(uniforms with offsets for the given bool values, row width) — floats, then colours."""
-    from brdfkit.glsl import Uniform
 
     offsets, k = {}, 0
     for p in f.params:
