@@ -174,20 +174,21 @@ def translate(text: str, uniforms: list[Uniform], *, path: str = "<shader>",
                  if u.type != "bool"), default=0)
     chan = width if channel_offset is None else int(channel_offset)
     try:
-        vals = {u.name: _uniform(u) for u in uniforms}
-        inputs = [V.vector((D.leaf(D.FLOAT, "in", f"{w}{c}") for c in "xyz"), tags=V.EQ)
-                  for w in ("i", "o")]
-        frame_n = V.vector((D.const(0.0), D.const(0.0), D.const(1.0)), tags=V.EQ | V.SCALARS)
-        frame_x = V.vector((D.const(1.0), D.const(0.0), D.const(0.0)),
-                           why="reads the tangent X")
-        frame_y = V.vector((D.const(0.0), D.const(1.0), D.const(0.0)),
-                           why="reads the bitangent Y")
-        out = run(tree.root_node, uniforms=vals, inputs=[*inputs, frame_n, frame_x, frame_y])
-        return _emit(out, chan, path, text, place)
+        with D.graph():
+            vals = {u.name: _uniform(u) for u in uniforms}
+            inputs = [V.vector((D.leaf(D.FLOAT, "in", f"{w}{c}") for c in "xyz"), tags=V.EQ)
+                      for w in ("i", "o")]
+            frame_n = V.vector((D.const(0.0), D.const(0.0), D.const(1.0)),
+                               tags=V.EQ | V.SCALARS)
+            frame_x = V.vector((D.const(1.0), D.const(0.0), D.const(0.0)),
+                               why="reads the tangent X")
+            frame_y = V.vector((D.const(0.0), D.const(1.0), D.const(0.0)),
+                               why="reads the bitangent Y")
+            out = run(tree.root_node, uniforms=vals,
+                      inputs=[*inputs, frame_n, frame_x, frame_y])
+            return _emit(out, chan, path, text, place)
     except Failure as f:
         raise BrdfkitError(f"{place(f.row, f.col)}: {f.message}") from None
-    finally:
-        D.reset()
 
 
 def _uniform(u: Uniform) -> V.Val:

@@ -21,15 +21,18 @@ only where it is multiplied by a literal 0 (e.g. the frame's zero components in
 
 Public objects (for the translator)
 -----------------------------------
-- :class:`Node`, :func:`const`, :func:`leaf`, :func:`op` — build the graph.
+- :class:`Node`, :func:`const`, :func:`leaf`, :func:`op` — build the graph (inside
+  :func:`graph`, one interning table per translation).
 - :func:`emit` — the graph as Python statements.
 """
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import math
 
-__all__ = ["Node", "const", "leaf", "op", "emit", "FLOAT", "BOOL"]
+__all__ = ["Node", "const", "leaf", "op", "emit", "graph", "FLOAT", "BOOL"]
 
 FLOAT, BOOL = "f", "b"
 
@@ -63,22 +66,34 @@ class Node:
         return f"{self.op}({', '.join(map(repr, self.args))})"
 
 
-_interned: dict = {}
+#: The interning table of the translation in progress (a context variable: translations in
+#: two threads, e.g. the explorer reloading two files, never share one); :func:`graph`
+#: gives each translation its own.
+_TABLE: contextvars.ContextVar = contextvars.ContextVar("brdfkit.glsl._dag._TABLE")
+
+
+@contextlib.contextmanager
+def graph():
+    """A fresh interning table for the nodes built inside the ``with`` block (one
+    translation); the nodes outlive it, the table does not."""
+    token = _TABLE.set({})
+    try:
+        yield
+    finally:
+        _TABLE.reset(token)
 
 
 def _intern(kind, op_, args, value):
+    table = _TABLE.get(None)
+    if table is None:
+        raise RuntimeError("brdfkit.glsl._dag: nodes are built inside `with graph():`")
     key = (kind, op_, tuple(id(a) for a in args), value)
-    node = _interned.get(key)
+    node = table.get(key)
     if node is None:
         node = Node(kind, op_, tuple(args), value)
-        _interned[key] = (node, args)  # args kept alive: their ids stay theirs
+        table[key] = (node, args)  # args kept alive: their ids stay theirs
         return node
     return node[0]
-
-
-def reset() -> None:
-    """Forget the interned nodes (after a translation: the graph is not needed again)."""
-    _interned.clear()
 
 
 def const(value) -> Node:
