@@ -58,8 +58,13 @@ from brdfkit._dual import drjit_version, formula
 from brdfkit.errors import BrdfkitError, DataFileError, ParameterError, UnknownModelError
 from brdfkit.formula import Declaration
 from brdfkit.models._drivers import _load
-from brdfkit.user.model import FormulaBRDF, ModelDefinition, SamplerFormulas, \
-    measure_isotropy, packer
+from brdfkit.user.model import (
+    FormulaBRDF,
+    ModelDefinition,
+    SamplerFormulas,
+    measure_isotropy,
+    packer,
+)
 
 __all__ = ["definition", "definitions"]
 
