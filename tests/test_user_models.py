@@ -308,6 +308,37 @@ def test_tabulated_sampler_passes_chi2(files, theta):
     assert r.passed, r.message
 
 
+def test_sampler_arguments_from_sampler_args(tmp_path):
+    p = _write(tmp_path, """
+        from brdfkit.formula import cos, maximum, select, sin
+
+        PI = 3.141592653589793
+
+        @formula
+        def f(ix, iy, iz, ox, oy, oz, rho, spread):
+            return rho / PI
+
+        @formula
+        def sample(ox, oy, oz, u0, u1, k):
+            c = u0 ** (1.0 / (k + 1.0))
+            s = sqrt(maximum(1.0 - c * c, 0.0))
+            return s * cos(2.0 * PI * u1), s * sin(2.0 * PI * u1), c
+
+        @formula
+        def pdf(ix, iy, iz, ox, oy, oz, k):
+            return select(iz > 0.0, (k + 1.0) / (2.0 * PI) * maximum(iz, 0.0) ** k, 0.0)
+
+        MODEL = define("f", eval=f, sample=sample, pdf=pdf,
+                       sampler_args=lambda v: (2.0 * v["spread"],),
+                       params=[Param("rho", 0.5, 0.0, 1.0), Param("spread", 1.5, 0.0, 10.0)])
+        """, "args.py")
+    m = brdfkit.model(p, spread=2.0)
+    assert m.formulas().args == (4.0,)
+    _, pdf = m.sample([0.0, 0.0, 1.0], [0.5, 0.25])
+    # k = 4: cos θ = 0.5^(1/5), pdf (k+1)/(2π) cos⁴ θ
+    assert float(pdf) == pytest.approx(5.0 / (2.0 * math.pi) * 0.5 ** 0.8, rel=1e-12)
+
+
 def test_the_users_sampler_is_used_and_chi2_tested(files):
     wo = np.array([0.5, 0.0, math.sqrt(0.75)])
     good = brdfkit.model(spec(files, "sampled"), k=5.0)
@@ -412,6 +443,16 @@ def test_errors_of_the_file(tmp_path, files):
         brdfkit.model(p)
     p = _write(tmp_path, "\nY = 1 / 0\n", "raises.py")
     with pytest.raises(DataFileError, match=r"raises\.py:3: ZeroDivisionError"):
+        brdfkit.model(p)
+    p = _write(tmp_path, """
+        @formula
+        def f(ix, iy, iz, ox, oy, oz, m):
+            return m
+
+        MODEL = define("f", eval=f, params=[Param("m", 1.0, kind="lobes")])
+        """, "kind.py")
+    with pytest.raises(DataFileError, match=r"kind\.py:7: define\('f'\): parameter 'm' has "
+                                            "kind 'lobes'; a user model's kinds: scalar"):
         brdfkit.model(p)
 
 
