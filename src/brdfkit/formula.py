@@ -8,15 +8,14 @@ parameters as :class:`Param`, and one :func:`define` that names them. brdfkit
 loads the file when a spec names it (``brdfkit.model("my_model.py")``,
 ``brdfkit check my_model.py``; ``my_model.py:NAME`` when it defines several)::
 
-    from brdfkit.formula import Param, define, exp, formula, log, select
+    from brdfkit.formula import Param, define, formula, pos_pow
 
     PI = 3.141592653589793
 
     @formula
     def phong(ix, iy, iz, ox, oy, oz, rho_d, rho_s, n):
         c = 2.0 * iz * oz - (ix * ox + iy * oy + iz * oz)    # R·V
-        lobe = select(c > 0.0, exp(n * log(select(c > 0.0, c, 1.0))), 0.0)
-        return rho_d / PI + rho_s * (n + 2.0) / (2.0 * PI) * lobe
+        return rho_d / PI + rho_s * (n + 2.0) / (2.0 * PI) * pos_pow(c, n)
 
     MODEL = define("phong", eval=phong, params=[
         Param("rho_d", 0.2, 0.0, 1.0, doc="diffuse albedo", kind="colour"),
@@ -52,7 +51,10 @@ Public objects
 - :class:`Declaration` — what :func:`define` returns (the loader collects it).
 - the primitives of :mod:`brdfkit._dual` (``select``, ``sqrt``, ``exp``,
   ``log``, ``log1p``, ``sin``, ``cos``, ``minimum``, ``maximum``,
-  ``absolute``, ``exp_nonpos`` …: every name of its ``__all__``).
+  ``absolute``, ``exp_nonpos`` …: every name of its ``__all__``), and
+  :func:`pos_pow` — max(0, x)ⁿ with 0⁰ = 1, the power of the built-in Phong
+  lobes (binary powers for integral n < 1024, ``pow`` otherwise; ``dr.power``
+  in Dr.Jit).
 """
 
 from __future__ import annotations
@@ -62,6 +64,7 @@ from dataclasses import dataclass
 
 from brdfkit import _dual
 from brdfkit.errors import ParameterError
+from brdfkit.models._lobes import lobe_pow as pos_pow
 from brdfkit.models._param import Param
 
 #: The primitives and the decorator, as :mod:`brdfkit._dual` exports them (new ones
@@ -69,7 +72,20 @@ from brdfkit.models._param import Param
 _DUAL = tuple(n for n in _dual.__all__ if n not in ("Formulas", "primitive", "drjit_version"))
 globals().update({n: getattr(_dual, n) for n in _DUAL})
 
-__all__ = [*_DUAL, "Param", "Declaration", "define"]  # noqa: PLE0604
+__all__ = [*_DUAL, "pos_pow", "Param", "Declaration", "define"]  # noqa: PLE0604
+
+
+def _pos_pow_drjit(dr):
+    def pos_pow_(x, n):
+        up = x > 0.0
+        return dr.select(up, dr.power(dr.select(up, x, 1.0), n),
+                         dr.select(n == 0.0, 1.0, 0.0))  # 0⁰ = 1
+    return pos_pow_
+
+
+# pos_pow(x, n) = max(0, x)ⁿ with 0⁰ = 1: the built-in Phong lobes' power (binary powers
+# for integral n < 1024, ~4x faster than pow), a primitive (Dr.Jit: dr.power)
+_dual.primitive(pos_pow, _pos_pow_drjit)
 
 #: The parameter kinds a user model may declare (per-lobe ones are the built-ins')
 USER_KINDS = ("scalar", "colour", "bool", "choice")

@@ -4,6 +4,9 @@ Model commands: ``models`` and ``eval``
 
 - ``brdfkit models [--json]`` — the registry: parameters (default, bounds,
   unit), citation, reciprocity claim, sampler.
+- ``brdfkit models FILE [--json]`` — the model(s) a user's ``.py`` or ``.brdf`` file
+  defines: parameters (kind, default, bounds, doc), detected isotropy and its reason,
+  the file's claims, notes (e.g. unsupported constructs ignored).
 - ``brdfkit eval MODEL -p NAME=VALUE ... --wi THETA,PHI --wo THETA,PHI`` —
   one BRDF value f_r in 1/sr.
 
@@ -16,6 +19,7 @@ import click
 
 import brdfkit
 from brdfkit.cli._common import build_model, emit_json, model_options, parse_direction
+from brdfkit.errors import BrdfkitError
 
 __all__ = ["models_cmd", "eval_cmd"]
 
@@ -34,16 +38,23 @@ def _param_row(p: dict) -> tuple[str, str, str, str]:
 
 
 @click.command("models")
+@click.argument("file", required=False, metavar="[FILE]")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON (a list of model descriptions).")
-def models_cmd(as_json: bool) -> None:
-    """List every registered model with its parameters, citation and claims.
+def models_cmd(file: str | None, as_json: bool) -> None:
+    """List every registered model with its parameters, citation and claims;
+    with FILE (a .py or .brdf file, PATH.py:NAME for one of several), the models it defines.
 
     For each model: aliases, whether its formula claims to be reciprocal,
     whether it has an importance sampler, the citation (paper and equation),
     and each parameter's default, bounds and unit. 'beta' (where listed) is
     the lobe half-angle alternative to the width parameter, in degrees on the
-    command line.
+    command line. For a FILE: each parameter's kind and doc, the detected
+    isotropy and why, the file's claims (reciprocity measured at the defaults
+    when not claimed), its sampler and notes.
     """
+    if file is not None:
+        _file_models(file, as_json)
+        return
     descriptions = [cls.describe() for cls in brdfkit.MODELS.values()]
     if as_json:
         emit_json(descriptions)
@@ -64,6 +75,55 @@ def models_cmd(as_json: bool) -> None:
         for r in rows:
             click.echo("      " + "  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True))
                        .rstrip())
+        click.echo("")
+
+
+def _claim(value) -> str:
+    return "not claimed" if value is None else f"claimed {_yes(value)}"
+
+
+def _file_models(file: str, as_json: bool) -> None:
+    from brdfkit.spec import ModelSpec
+    from brdfkit.user.model import FormulaBRDF
+
+    kind = ModelSpec(file).kind
+    if kind not in ("python-file", "brdf-file"):
+        raise BrdfkitError(f"brdfkit models FILE takes a .py or .brdf file (PATH.py:NAME for "
+                           f"one model of several); got {file!r} ('brdfkit models' lists the "
+                           "registered models)")
+    if kind == "python-file" and file.strip().lower().endswith(".py"):  # every model of it
+        from brdfkit.user.python_file import definitions
+        models = [FormulaBRDF(d) for d in definitions(file.strip())]
+    else:
+        models = [brdfkit.model(file)]
+    descriptions = [m.describe() for m in models]
+    if as_json:
+        emit_json(descriptions)
+        return
+    for d in descriptions:
+        click.echo(f"{d['name']}  ({d['source']}; spec {d['target']})")
+        if d["summary"]:
+            click.echo(f"    {d['summary']}")
+        click.echo(f"    isotropic: {_yes(d['isotropic'])} ({d['isotropy_reason']})")
+        claims = d["claims"]
+        measured = ("" if claims["reciprocal"] is not None else
+                    f" (measured at the defaults: {_yes(d['reciprocal'])})")
+        click.echo(f"    reciprocal: {_claim(claims['reciprocal'])}{measured}   energy "
+                   f"conserving: {_claim(claims['energy_conserving'])} (brdfkit check "
+                   "computes both)")
+        click.echo("    sampler: " + ("the file's own" if d["own_sampler"] else
+                                      "tabulated from its values (cosine + half vector)"))
+        if d["citation"]:
+            click.echo(f"    cite: {d['citation']}")
+        for note in d["notes"]:
+            click.echo(f"    note: {note}")
+        rows = [(*_param_row(p)[:3], p["kind"], p["doc"]) for p in d["params"]]
+        widths = [max(len(r[i]) for r in rows) for i in range(5)] if rows else []
+        for r in rows:
+            click.echo("      " + "  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True))
+                       .rstrip())
+        if not rows:
+            click.echo("      (no parameters)")
         click.echo("")
 
 

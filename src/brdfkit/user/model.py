@@ -469,4 +469,4 @@ class FormulaBRDF(TabulatedSampler, DerivedBRDF):
                 "isotropic": bool(d.isotropic), "isotropy_reason": d.isotropy_reason,
                 "claims": {"reciprocal": d.reciprocal,
                            "energy_conserving": d.energy_conserving},
-                "notes": list(d.notes)}
+                "own_sampler": d.sampler is not None, "notes": list(d.notes)}
