@@ -163,8 +163,9 @@ def _dirs(theta_deg, phi_deg) -> np.ndarray:
 
 
 def _reciprocity(model) -> tuple[float, int, int]:
-    """(asymmetry over the pairs where both values exist, pairs without both, all pairs)."""
-    if model.isotropic:
+    """(asymmetry over the pairs where both values exist, pairs without both, all pairs).
+    A plain callable claims nothing: it gets the anisotropic pair set."""
+    if isinstance(model, BRDF) and model.isotropic:
         ti, to, dp = np.meshgrid(_PAIR_THETA_DEG, _PAIR_THETA_DEG, _PAIR_DPHI_DEG,
                                  indexing="ij")
         pl = np.zeros(ti.size)

@@ -17,9 +17,9 @@ nodes (:mod:`._dag`), so the result is the BRDF as one expression per colour cha
   its own scopes (globals visible; writing a global is refused). A user function hides
   every built-in of its name, as GLSL ≥ 1.30 scopes them and Mesa compiles them (a file's
   own ``reflect`` with the opposite sign is the one called); overloads are chosen by
-  exact argument types, then with int → float conversion. A function is visible from its first declaration
-  (prototype or definition) on: a call above it reaches the built-in. Recursion is
-  refused.
+  exact argument types, then with int → float conversion. A function is visible from its
+  first declaration (prototype or definition) on: a call above it reaches the built-in.
+  Recursion is refused.
 - Declarations: ``const`` and other globals, locals in block scopes, several declarators per
   line; uninitialised locals are 0.
 

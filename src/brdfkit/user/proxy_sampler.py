@@ -84,6 +84,7 @@ from brdfkit._dual import Formulas, cos, formula, maximum, minimum, select, sin,
 from brdfkit.errors import ParameterError
 from brdfkit.halfangle import trowbridge_reitz_c_from_beta
 from brdfkit.models._base import VECTOR_OPTIONS
+from brdfkit.models._drivers import loop_driver
 from brdfkit.models.microfacet import walter_pdf, walter_sample
 from brdfkit.models.sampling import Strategy
 
@@ -174,11 +175,10 @@ def _sample_rows(wo, u, alpha, w_c, wi):  # pragma: no cover - compiled
         wi[j, 2] = z
 
 
-@numba.njit(cache=True, **VECTOR_OPTIONS)
-def _pdf_rows(wi, wo, alpha, w_c, out):  # pragma: no cover - compiled
-    for j in range(wi.shape[0]):
-        out[j] = proxy_pdf(wi[j, 0], wi[j, 1], wi[j, 2], wo[j, 0], wo[j, 1], wo[j, 2],
-                           alpha, w_c)
+@formula
+def _pdf_kernel(ix, iy, iz, ox, oy, oz, p):
+    """proxy_pdf as a kernel over the packed row (α, w_c): run by the generated pair loop."""
+    return proxy_pdf(ix, iy, iz, ox, oy, oz, p[0], p[1])
 
 
 def _rows(a: np.ndarray, shape: tuple, k: int) -> np.ndarray:
@@ -220,8 +220,9 @@ class ProxyStrategy(Strategy):
 
     def pdf(self, wi, wo):
         shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
-        out = np.empty(int(np.prod(shape)))
-        _pdf_rows(_rows(wi, shape, 3), _rows(wo, shape, 3), self.alpha, self.w_c, out)
+        out = np.empty((int(np.prod(shape)), 1))
+        loop_driver(_pdf_kernel, loop="plain")(
+            _rows(wi, shape, 3), _rows(wo, shape, 3), np.array([[self.alpha, self.w_c]]), out)
         return out.reshape(shape)
 
     def __repr__(self) -> str:
