@@ -32,6 +32,7 @@ import numba
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from test_cli_inputs import assert_one_line_error  # the CLI's error contract
 
 import brdfkit
 from brdfkit._kern import INV_PI, below_horizon, half
@@ -338,16 +339,6 @@ def test_the_ambient_table_refuses_an_anisotropic_model(model):
 # --------------------------------------------------------------------------- the CLI
 def run(*args: str):
     return CliRunner().invoke(main, list(args))
-
-
-def assert_one_line_error(result, *fragments: str) -> None:
-    assert result.exit_code == 2, (result.exit_code, result.output)
-    err = result.stderr.strip().splitlines()
-    assert len(err) == 1, result.stderr
-    assert err[0].startswith("brdfkit: error: "), err[0]
-    assert "Traceback" not in result.output + result.stderr
-    for frag in fragments:
-        assert frag in err[0], (frag, err[0])
 
 
 @pytest.fixture()

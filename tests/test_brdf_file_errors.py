@@ -23,6 +23,7 @@ import sys
 import pytest
 from click.testing import CliRunner
 from glsl_reference import CORPUS
+from test_cli_inputs import assert_one_line_error  # the CLI's error contract
 
 import brdfkit
 from brdfkit.cli import main
@@ -41,17 +42,6 @@ def _position(name: str, line: int, token: str) -> tuple:
 
 def _run(*args: str):
     return CliRunner().invoke(main, list(args))
-
-
-def _one_error_line(result) -> str:
-    """Exit status 2, exactly one line on stderr starting 'brdfkit: error: ', no traceback."""
-    assert result.exit_code == 2, (result.exit_code, result.output, result.stderr)
-    err = result.stderr.strip().splitlines()
-    assert len(err) == 1, result.stderr
-    assert err[0].startswith("brdfkit: error: "), err[0]
-    assert "Traceback" not in result.output + result.stderr
-    assert result.exception is None or isinstance(result.exception, SystemExit)
-    return err[0]
 
 
 def _where(line: str, name: str):
@@ -99,14 +89,14 @@ def _check_message(line: str, name: str, case: dict) -> None:
 
 @pytest.mark.parametrize("command", ["eval", "check"])
 @pytest.mark.parametrize("name", sorted(CASES))
-def test_bad_file_one_error_line(name, command):
+def test_bad_fileassert_one_line_error(name, command):
     extra = ["--wi", "30,0", "--wo", "30,180"] if command == "eval" else []
-    line = _one_error_line(_run(command, str(BAD / name), *extra))
+    line = assert_one_line_error(_run(command, str(BAD / name), *extra))
     _check_message(line, name, CASES[name])
 
 
 def test_malformed_parameter_line_names_the_file_and_line():
-    line = _one_error_line(_run("eval", str(BAD / "malformed_parameter.brdf"),
+    line = assert_one_line_error(_run("eval", str(BAD / "malformed_parameter.brdf"),
                                 "--wi", "30,0", "--wo", "30,180"))
     at_line, _ = _where(line, "malformed_parameter.brdf")
     assert at_line == 7 and "ks" in line and "one" in line, line
@@ -144,13 +134,13 @@ BOOL_FILE = CORPUS / "oren_nayar.brdf"      # float sigma, bool qualitative, col
 
 
 def test_parameter_outside_its_range_names_it_and_the_range():
-    line = _one_error_line(_run("eval", str(GOOD_FILE), "-p", "m=2",
+    line = assert_one_line_error(_run("eval", str(GOOD_FILE), "-p", "m=2",
                                 "--wi", "30,0", "--wo", "30,180"))
     assert "'m'" in line and "0.05" in line and "1" in line and "2" in line, line
 
 
 def test_unknown_parameter_names_it_and_lists_the_valid_names():
-    line = _one_error_line(_run("eval", str(GOOD_FILE), "-p", "nosuch=1",
+    line = assert_one_line_error(_run("eval", str(GOOD_FILE), "-p", "nosuch=1",
                                 "--wi", "30,0", "--wo", "30,180"))
     assert "nosuch" in line, line
     for valid in ("m", "metal", "base", "F0"):
@@ -159,7 +149,7 @@ def test_unknown_parameter_names_it_and_lists_the_valid_names():
 
 @pytest.mark.parametrize("value", ["maybe", "2", "0.5"])
 def test_bad_bool_value_names_the_parameter(value):
-    line = _one_error_line(_run("eval", str(BOOL_FILE), "-p", f"qualitative={value}",
+    line = assert_one_line_error(_run("eval", str(BOOL_FILE), "-p", f"qualitative={value}",
                                 "--wi", "30,0", "--wo", "30,180"))
     assert "qualitative" in line and value in line, line
 
