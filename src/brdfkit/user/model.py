@@ -225,12 +225,15 @@ def packer(params, n_channels: int | None = None) -> Callable[[dict], np.ndarray
 def interpreted_driver(kernel) -> Callable:
     """``driver(wi, wo, P, out) -> n_bad`` as :func:`~brdfkit.models._drivers.loop_driver`
     gives, running the NumPy version of the formula *kernel* (:func:`numpy_version`) over
-    all pairs at once, one packed row (channel) at a time: no compilation, the same
-    values (NumPy's IEEE arithmetic, ``select`` both sides evaluated as in the compiled
-    loop; the row's entries are ``np.float64``, so a division by 0 is ±inf or NaN, never
-    ``ZeroDivisionError``). Pairs that are not finite unit vectors (|‖w‖² − 1| >
-    UNIT_TOL) are counted and nothing is evaluated (the caller raises). Raises
-    ``TypeError`` when the formula has no NumPy version."""
+    all pairs at once: no compilation, the same values (NumPy's IEEE arithmetic, ``select``
+    both sides evaluated as in the compiled loop; libm's exp/log/pow may differ from
+    LLVM's in the last bit). All channels in one pass: a column of the packed rows that is
+    the same in every row is one ``np.float64`` (so a division by 0 is ±inf or NaN, never
+    ``ZeroDivisionError``, and a Python ``if`` on a flag works as compiled), a column that
+    differs a (C, 1) array, so what does not depend on the channel (the geometry) is
+    computed once. Pairs that are not finite unit vectors (|‖w‖² − 1| > UNIT_TOL) are
+    counted and nothing is evaluated (the caller raises). Raises ``TypeError`` when the
+    formula has no NumPy version."""
     f = numpy_version(kernel)
 
     def driver(wi, wo, P, out) -> int:
@@ -240,9 +243,12 @@ def interpreted_driver(kernel) -> Callable:
         if n_bad:
             return n_bad
         args = tuple(np.ascontiguousarray(w[:, k]) for w in (wi, wo) for k in range(3))
+        row = tuple(np.float64(col[0]) if np.all(col == col[0]) else col.reshape(-1, 1)
+                    for col in np.asarray(P, dtype=np.float64).T)
         with np.errstate(all="ignore"):  # as the compiled loop: IEEE results, no warning
-            for c in range(P.shape[0]):
-                out[:, c] = f(*args, tuple(np.float64(x) for x in P[c]))
+            f_r = f(*args, row)
+        out[:] = np.broadcast_to(np.asarray(f_r, dtype=np.float64),
+                                 (P.shape[0], out.shape[0])).T
         return 0
 
     return driver
