@@ -29,12 +29,14 @@ Models from files (:mod:`brdfkit.explorer.files`): a spec whose target is a file
 (``.binary``, ``.brdf``, ``.py[:NAME]``) is watched; its entry in ``/api/views`` also
 has ``file``, ``digest``, ``decl`` (its parameter declarations: the page builds the
 controls from them), ``dropped`` (parameters the page sent that this version of the
-file does not declare; the page forgets them) and ``reload_error`` (the newest
-version's error while the last good version is drawn). ``version`` in the answer is
-the watch version before the models were built: the page polls ``/api/changes`` with
-it and redraws when a file changed. ``/api/open`` takes a request from this machine
-only and is the one way a Python file (which runs code) is loaded besides the command
-line (``files`` module docstring, "Security").
+file does not declare; the page forgets them), ``reload_error`` (the newest
+version's error while the last good version is drawn) and ``compiled`` (false: the
+version's interpreted draft, drawn while its kernel compiles in the background; the
+watch version moves when the compiled model is ready, ``files`` module docstring).
+``version`` in the answer is the watch version before the models were built: the page
+polls ``/api/changes`` with it and redraws when a file changed. ``/api/open`` takes a
+request from this machine only and is the one way a Python file (which runs code) is
+loaded besides the command line (``files`` module docstring, "Security").
 
 Why FastAPI and not Panel: a slider move must redraw every view in 100 ms, and
 measured (``benchmarks/bench_explorer.py``, one analytic model) a direction move
