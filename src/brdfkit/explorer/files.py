@@ -218,7 +218,8 @@ def _load(load, target: str):
     except BrdfkitError as exc:
         return str(exc)
     except Exception as exc:  # noqa: BLE001 - a user's Python file may raise anything
-        return f"{target}: {type(exc).__name__}: {exc}"
+        first = next((ln.strip() for ln in str(exc).splitlines() if ln.strip()), "")
+        return f"{target}: {type(exc).__name__}: {first}"
 
 
 class FileModels:
@@ -291,12 +292,14 @@ class FileModels:
     def _compile(self, key: tuple, path: str, params: dict) -> None:
         target, digest = key
         kind = _kind(target)
-        got = _load(kind.resolve, target)
-        if not isinstance(got, str) and self._warm is not None:
-            try:
-                self._warm(kind.build(got, params))
-            except Exception as exc:  # noqa: BLE001 - a user's formula may raise anything
-                got = f"{target}: {type(exc).__name__}: {exc}"
+
+        def compiled(t):
+            template = kind.resolve(t)
+            if self._warm is not None:
+                self._warm(kind.build(template, params))
+            return template
+
+        got = _load(compiled, target)
         with self._lock:
             self._templates[key] = got
             good = self._good.get(target)
