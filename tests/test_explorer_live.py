@@ -422,9 +422,9 @@ def test_page_opens_a_file_by_path(browser, server, tmp_path):
 
 
 def test_page_brdf_file_live(browser, server, tmp_path):
-    """A ``.brdf`` in the page: a saved edit of its default reloads it within a second (the
-    formula is unchanged, so no compile); a formula edit compiles a new kernel (measured);
-    a syntax error shows file:line:col and keeps the drawing."""
+    """A ``.brdf`` in the page: a saved edit of its default reloads it within a second; a
+    formula edit (measured; held to 1 s by test_page_formula_edit_within_a_second); a
+    syntax error shows file:line:col and keeps the drawing."""
     pytest.importorskip("brdfkit.user.brdf_file")
     p = tmp_path / "lambert.brdf"
     p.write_text(LAMBERT_BRDF)
@@ -470,7 +470,7 @@ def test_page_brdf_bool_is_a_checkbox(browser, server, tmp_path):
 
 def test_page_python_file_opened_by_path_and_live(browser, server, tmp_path):
     """A ``.py`` model: refused from a link, loaded once its path is typed into "open
-    file", then reloaded when saved (a parameter-default edit: no new kernel)."""
+    file", then reloaded when saved (a parameter-default edit)."""
     pytest.importorskip("brdfkit.user.python_file")
     py = tmp_path / "lam.py"
     py.write_text(LAMBERT_PY.format(scale=1.0, name="rho"))
@@ -482,10 +482,11 @@ def test_page_python_file_opened_by_path_and_live(browser, server, tmp_path):
     t0 = time.perf_counter()
     py.write_text(LAMBERT_PY.format(scale=1.0, name="rho").replace('"rho", 0.5', '"rho", 0.9'))
     _wait_value(page, 1, 0.9 / math.pi, 60_000)
-    # not held to 1 s here: measured 3.9-7.4 s, all of it the .py loader compiling the
-    # file's formulas again with Numba on every load (brdfkit.user.python_file, not the
-    # explorer; the .brdf loader's cache on content makes the same edit 0.17 s)
-    print(f".py reload (a default edit): {time.perf_counter() - t0:.2f} s")
+    # the .py loader compiles a file's formulas on every load (a new content: a new module);
+    # the explorer draws the interpreted draft meanwhile (3.9-7.4 s before it; 0.24 s now)
+    latency = time.perf_counter() - t0
+    print(f".py reload (a default edit): {latency:.2f} s")
+    assert latency <= 3.0, latency  # one save on a shared machine; best of 3 ≤ 1 s below
     assert errors == []
     page.close()
 
@@ -528,3 +529,190 @@ def test_explore_command_serves_file_specs(tmp_path):
     finally:
         proc.terminate()
         proc.wait(timeout=30)
+
+
+# --------------------------------------------------------------------------- formula edits
+# A formula edit builds a new kernel: the explorer draws the interpreted draft at once
+# (the kernel's NumPy version, brdfkit._dual.numpy_version) and compiles in a background
+# thread, then the page draws the compiled model (files module docstring). Each edit puts a
+# random constant in the formula, so no disk cache holds its kernel.
+PRINCIPLED = os.path.join(os.path.dirname(__file__), os.pardir, "benchmarks", "brdf",
+                          "principled.brdf")
+WALTER = os.path.join(os.path.dirname(__file__), "brdf_files", "walter_ggx.brdf")
+
+
+def _scaled_principled(k: float) -> str:
+    """principled.brdf with its result multiplied by *k* (f = k·f₁: the reference)."""
+    with open(PRINCIPLED) as fh:
+        text = fh.read()
+    assert text.count("    return (INV_PI") == 1 and text.count("* dr;\n}") == 1
+    return (text.replace("    return (INV_PI", f"    return {k!r} * ((INV_PI")
+            .replace("* dr;\n}", "* dr);\n}"))
+
+
+def _random_pairs(n, seed):
+    rng = np.random.default_rng(seed)
+    w = rng.normal(size=(2, n, 3))
+    w[..., 2] = np.abs(w[..., 2]) + 1e-3
+    return w / np.linalg.norm(w, axis=-1, keepdims=True)
+
+
+def test_interpreted_model_equals_the_compiled_one(tmp_path):
+    """The draft (``compiled=False``: kernel None, the NumPy version) gives the compiled
+    model's values bit for bit on principled.brdf (anisotropic, 3 channels), Walter GGX and
+    a Python file's model; the generic engines (albedo, check, the sphere) take it."""
+    pytest.importorskip("brdfkit.user.brdf_file")
+    from brdfkit.analysis import albedo, check
+    from brdfkit.render import render_sphere
+    from brdfkit.user import brdf_file, python_file
+    from brdfkit.user.model import FormulaBRDF
+
+    py = tmp_path / "lam.py"
+    py.write_text(LAMBERT_PY.format(scale=1.25, name="rho"))
+    wi, wo = _random_pairs(4000, 3)
+    cases = [(brdf_file.definition, PRINCIPLED, {"roughness": 0.3, "anisotropic": 0.6,
+                                                   "sheen": 0.4, "clearcoat": 0.7}),
+             (brdf_file.definition, WALTER, {}),
+             (python_file.definition, str(py), {"rho": 0.7})]
+    for load, path, values in cases:
+        compiled = FormulaBRDF(load(path), **values)
+        draft = FormulaBRDF(load(path, compiled=False), **values)
+        assert draft.definition.interpreted and draft.kernel is None, path
+        assert compiled.kernel is not None and not compiled.definition.interpreted
+        np.testing.assert_array_equal(draft.eval(wi, wo), compiled.eval(wi, wo), err_msg=path)
+        theta = np.radians([5.0, 45.0, 80.0])
+        np.testing.assert_allclose(albedo(draft, theta).albedo, albedo(compiled, theta).albedo,
+                                   rtol=1e-15, atol=0)
+        assert check(draft).to_dict() == check(compiled).to_dict()
+        np.testing.assert_array_equal(render_sphere(draft, phi_l=0.5, size=48).radiance,
+                                      render_sphere(compiled, phi_l=0.5, size=48).radiance)
+        assert brdfkit.ModelSpec.of(draft).build().kernel is not None  # rebuilt compiled
+    with pytest.raises(brdfkit.BrdfkitError, match="unit vectors"):
+        draft.eval(np.array([0.0, 0.0, 2.0]), np.array([0.0, 0.0, 1.0]))
+
+
+def _views(c, state):
+    r = c.post("/api/views", json=state)
+    assert r.status_code == 200, r.text
+    return r.json()
+
+
+def _join_compiles(c):
+    for t in list(c.app.state.files.threads):
+        t.join(timeout=300)
+        assert not t.is_alive()
+
+
+def test_api_formula_edit_draft_then_compiled(tmp_path):
+    """A formula edit: the first answer is the interpreted draft (``compiled`` false), the
+    compile raises the file's version (``/api/changes`` names the file) and the next answer
+    is the compiled model with the same values; a .py formula Numba cannot compile (an int
+    constant beyond 64 bits) is drawn as a draft, then its error shown with the last
+    compiled version drawn."""
+    pytest.importorskip("brdfkit.user.python_file")
+    from fastapi.testclient import TestClient
+
+    from brdfkit.explorer.app import create_app
+
+    rng = np.random.default_rng()
+    p, py = tmp_path / "lam.brdf", tmp_path / "lam.py"
+    k = 1.0 + float(rng.random())
+    p.write_text(LAMBERT_BRDF.replace("rho / 3.14", f"{k!r} * rho / 3.14"))
+    py.write_text(LAMBERT_PY.format(scale=k, name="rho"))
+    c = TestClient(create_app(opened=[str(py)]), **LOCAL)
+    for f, rtol in ((p, 1e-6), (py, 1e-12)):
+        state = {"models": [{"spec": str(f), "params": {"rho": 0.4}}]}
+        first = _views(c, state)
+        m = first["models"][0]
+        assert m.get("compiled") is False and m["reload_error"] is None, (f, m.get("error"))
+        np.testing.assert_allclose(_slice0(m), k * 0.4 / math.pi, rtol=rtol)
+        _join_compiles(c)
+        ch = c.get(f"/api/changes?since={first['version']}").json()
+        assert ch["changed"] == [str(f)] and ch["version"] > first["version"]
+        m2 = _views(c, state)["models"][0]
+        assert m2["compiled"] is True and m2["digest"] == m["digest"]
+        for got, want in ((m["polar"]["values"], m2["polar"]["values"]),
+                          (m["curves"]["theta_h"], m2["curves"]["theta_h"]),
+                          (m["albedo"]["values"], m2["albedo"]["values"])):
+            np.testing.assert_allclose(got, want, rtol=1e-12, atol=0)
+    bad = LAMBERT_PY.format(scale=k, name="rho").replace("PI = ", "BIG = 2 ** 70\nPI = ") \
+        .replace("return ", "return BIG / BIG * 2.0 * ")
+    py.write_text(bad)
+    state = {"models": [{"spec": str(py), "params": {"rho": 0.4}}]}
+    m = _views(c, state)["models"][0]
+    assert m["compiled"] is False and m["reload_error"] is None
+    np.testing.assert_allclose(_slice0(m), 2 * k * 0.4 / math.pi, rtol=1e-12)
+    _join_compiles(c)
+    m = _views(c, state)["models"][0]
+    assert "does not compile" in m["reload_error"] and str(py) in m["reload_error"], m
+    assert m["compiled"] is True
+    np.testing.assert_allclose(_slice0(m), k * 0.4 / math.pi, rtol=1e-12)  # the last compiled
+
+
+def _edit_and_time(page, k_index, path, text, want, staged):
+    """Save *text* to *path* atomically; (seconds until the page draws *want* from the
+    interpreted draft, the draft's polar values)."""
+    staged.write_text(text)
+    _wait_verdict(page)
+    t0 = time.perf_counter()
+    os.replace(staged, path)
+    page.wait_for_function(
+        f"(({SLICE0})({k_index}) !== null) && Math.abs(({SLICE0})({k_index}) - {want!r}) "
+        f"< {1e-9 * want!r} && lastViews.models[{k_index}].compiled === false",
+        timeout=10_000, polling=10)
+    latency = time.perf_counter() - t0
+    return latency, page.evaluate(f"lastViews.models[{k_index}].polar.values")
+
+
+def _wait_compiled(page, k_index, draft_values, file_id):
+    page.wait_for_function(f"lastViews.models[{k_index}].compiled === true",
+                           timeout=300_000, polling=50)
+    np.testing.assert_allclose(page.evaluate(f"lastViews.models[{k_index}].polar.values"),
+                               draft_values, rtol=1e-12, atol=0)
+    assert "interpreted" not in page.locator(file_id).text_content()
+
+
+def test_page_formula_edit_within_a_second(browser, server, tmp_path):
+    """In Chromium: three saves of a new formula of principled.brdf (each × a random
+    constant: f = k·f₁, f₁ the page's value before) and three of a .py model's formula
+    (k·ρ/π) are drawn within a second (best of three), by the draft; then the page draws
+    the compiled model, the same values to 1e-12; a broken edit keeps the last good one."""
+    pytest.importorskip("brdfkit.user.python_file")
+    rng = np.random.default_rng()
+    p = tmp_path / "principled.brdf"
+    p.write_text(_scaled_principled(1.0))
+    py = tmp_path / "lam.py"
+    py.write_text(LAMBERT_PY.format(scale=1.0, name="rho"))
+    page, errors = _open(browser, _url(server, [str(p)]))
+    page.wait_for_function(f"(({SLICE0})(0)) > 0", timeout=120_000)
+    page.fill("#open-path", str(py))
+    page.click("#open-button")
+    _wait_value(page, 1, 0.5 / math.pi, 120_000)
+    page.wait_for_function("lastViews.models.every(v => v.compiled === true)", timeout=300_000)
+    base = page.evaluate(f"({SLICE0})(0)")
+    measured = {".brdf": [], ".py": []}
+    for _ in range(3):
+        k = 1.0 + float(rng.random())
+        lat, draft = _edit_and_time(page, 0, p, _scaled_principled(k), k * base,
+                                    tmp_path / "staged.brdf")
+        assert "interpreted (compiling" in page.locator("#model-file-0").text_content()
+        measured[".brdf"].append(lat)
+        _wait_compiled(page, 0, draft, "#model-file-0")
+        k = 1.0 + float(rng.random())
+        lat, draft = _edit_and_time(page, 1, py, LAMBERT_PY.format(scale=k, name="rho"),
+                                    k * 0.5 / math.pi, tmp_path / "staged.py")
+        measured[".py"].append(lat)
+        _wait_compiled(page, 1, draft, "#model-file-1")
+    print(f"formula edit → drawn (s): {measured}")
+    # the best of three within a second (as the .binary test: the machine is shared)
+    for kind, lat in measured.items():
+        assert min(lat) <= 1.0 and max(lat) <= 3.0, (kind, lat)
+    drawn = page.evaluate(f"({SLICE0})(0)")
+    p.write_text(_scaled_principled(2.0).replace("return ", "return (", 1))  # broken
+    page.wait_for_function("document.getElementById('model-error-0').textContent"
+                           ".includes('not reloaded')", timeout=10_000)
+    assert re.search(re.escape(str(p)) + r":\d+:\d+",
+                     page.locator("#model-error-0").text_content())
+    assert page.evaluate(f"({SLICE0})(0)") == drawn
+    assert errors == []
+    page.close()

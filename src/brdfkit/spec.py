@@ -108,7 +108,9 @@ class SpecKind:
 
     ``claims(name)`` says whether a name is of this kind; ``resolve(name)`` gives
     a template with ``.name`` (canonical) and ``.params`` (declarations) — a model
-    class or a model object — and ``build(template, params)`` the model.
+    class or a model object — and ``build(template, params)`` the model; ``draft(name)``,
+    when not None, a template built the same way that compiles nothing (interpreted models:
+    the explorer draws them while ``resolve`` compiles; ``docs/architecture.md``).
     """
 
     name: str
@@ -116,6 +118,7 @@ class SpecKind:
     claims: Callable[[object], bool]
     resolve: Callable[[object], object]
     build: Callable[[object, dict], BRDF]
+    draft: Callable[[object], object] | None = None
 
 
 def _unknown(name, err: UnknownModelError) -> UnknownModelError:
@@ -173,14 +176,14 @@ def _is_brdf_file(name) -> bool:
 
 # the user's files are read on first use (brdfkit.user: its loaders, Numba, the tabulated
 # sampler), not with the package
-def _python_definition(name):
+def _python_definition(name, compiled: bool = True):
     from brdfkit.user.python_file import definition
-    return definition(_path_text(name))
+    return definition(_path_text(name), compiled=compiled)
 
 
-def _brdf_definition(name):
+def _brdf_definition(name, compiled: bool = True):
     from brdfkit.user.brdf_file import definition
-    return definition(_path_text(name))
+    return definition(_path_text(name), compiled=compiled)
 
 
 def _user_model(definition, params: dict) -> BRDF:
@@ -193,9 +196,10 @@ def _user_model(definition, params: dict) -> BRDF:
 #: naming a ``.py``/``.brdf`` file is theirs, any other path a MERL file's).
 KINDS: tuple[SpecKind, ...] = (
     SpecKind("python-file", "PATH.py or PATH.py:NAME (a model written in Python)",
-             _is_python_file, _python_definition, _user_model),
+             _is_python_file, _python_definition, _user_model,
+             lambda name: _python_definition(name, compiled=False)),
     SpecKind("brdf-file", "PATH.brdf (a BRDF Explorer file)", _is_brdf_file, _brdf_definition,
-             _user_model),
+             _user_model, lambda name: _brdf_definition(name, compiled=False)),
     SpecKind("material", "merl:NAME[@nbrdf|@npf|@abc|@sgd], rgl:NAME, nielsen:NAME",
              _is_builtin, material, _with_params),
     SpecKind("merl-file", "PATH.binary (a MERL file)", _is_merl_file, _merl_file, _with_params),

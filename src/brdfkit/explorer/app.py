@@ -29,12 +29,14 @@ Models from files (:mod:`brdfkit.explorer.files`): a spec whose target is a file
 (``.binary``, ``.brdf``, ``.py[:NAME]``) is watched; its entry in ``/api/views`` also
 has ``file``, ``digest``, ``decl`` (its parameter declarations: the page builds the
 controls from them), ``dropped`` (parameters the page sent that this version of the
-file does not declare; the page forgets them) and ``reload_error`` (the newest
-version's error while the last good version is drawn). ``version`` in the answer is
-the watch version before the models were built: the page polls ``/api/changes`` with
-it and redraws when a file changed. ``/api/open`` takes a request from this machine
-only and is the one way a Python file (which runs code) is loaded besides the command
-line (``files`` module docstring, "Security").
+file does not declare; the page forgets them), ``reload_error`` (the newest
+version's error while the last good version is drawn) and ``compiled`` (false: the
+version's interpreted draft, drawn while its kernel compiles in the background; the
+watch version moves when the compiled model is ready, ``files`` module docstring).
+``version`` in the answer is the watch version before the models were built: the page
+polls ``/api/changes`` with it and redraws when a file changed. ``/api/open`` takes a
+request from this machine only and is the one way a Python file (which runs code) is
+loaded besides the command line (``files`` module docstring, "Security").
 
 Why FastAPI and not Panel: a slider move must redraw every view in 100 ms, and
 measured (``benchmarks/bench_explorer.py``, one analytic model) a direction move
@@ -165,13 +167,23 @@ def _b64(png: bytes) -> str:
     return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
 
 
+def _warm(m) -> None:
+    """Evaluate a just-compiled file model as the page will (the views at one direction:
+    Numba compiles their loops in the compiling thread, not in the page's request)."""
+    views.sphere(m, phi_l=0.5)
+    views.polar(m, 0.5), views.lobe(m, 0.5), views.curves(m, 0.5), views.halfdiff(m)
+    views.albedo_curve(m)
+
+
 def create_app(*, opened=()):
     """The FastAPI application (one model cache per app); *opened*: files the user named
     (the command line's specs), which may run code (:mod:`brdfkit.explorer.files`)."""
     app = FastAPI(title="brdfkit explorer", docs_url=None, redoc_url=None)
     cache = bounded_cache(None, maxsize=_CACHE_SIZE)  # this app's models and views
     static = resources.files("brdfkit.explorer") / "static"
-    from_files = files.FileModels(opened=[p for p in map(files.spec_file, opened) if p])
+    from_files = files.FileModels(opened=[p for p in map(files.spec_file, opened) if p],
+                                  warm=_warm)
+    app.state.files = from_files  # the tests join its compiling threads
 
     def _key(entry: dict) -> str:
         return json.dumps({k: entry.get(k) for k in ("spec", "params", "pump", "times")},
@@ -190,7 +202,9 @@ def create_app(*, opened=()):
         if path is None:
             return _cached(_key(entry), lambda: (build_entry(entry), {}))
         digest = from_files.watcher.digest(path)
-        return _cached(_key(entry) + "|file|" + str(digest), lambda: from_files.build(
+        stage = from_files.stage(entry["spec"], path, digest)  # a draft, then compiled
+        key = _key(entry) + "|file|" + str(digest) + "|" + stage
+        return _cached(key, lambda: from_files.build(
             entry["spec"], path, digest, _page_params(entry),
             lambda kept: entry_spec({**entry, "params": kept})))
 
@@ -208,6 +222,7 @@ def create_app(*, opened=()):
             return {"albedo": views.albedo_curve(m, mode=mode, phi=phi),
                     "halfdiff": _b64(png_h), "halfdiff_info": hd}
         return _cached(_key(entry) + "|" + info.get("digest", "") + "|views|" + mode
+                       + ("" if info.get("compiled", True) else "|interpreted")
                        + ("" if m.isotropic else f"|{phi!r}"), make)
 
     @app.exception_handler(BrdfkitError)
@@ -271,6 +286,7 @@ def create_app(*, opened=()):
                 path = files.spec_file(spec)
                 out.append({"spec": spec, "error": str(exc),
                             **({"file": path} if path else {})})
+        from_files.start_compiles()  # the drafts drawn: compile them now (files docstring)
         return to_jsonable({"models": out, "version": version,
                             "ms": round(1e3 * (time.perf_counter() - t0), 1)})
 

@@ -18,7 +18,16 @@ target itself is a file, or it is ``PATH.py:NAME`` and ``PATH.py`` is one) — a
   (a changed file never returns the stale model), keeps the parameter values the new
   version still declares (the others are dropped and named), and when a new version
   fails to load keeps drawing the last good one with the error (the loader's one-line
-  message, e.g. ``file:line:col`` of a ``.brdf``) beside it.
+  message, e.g. ``file:line:col`` of a ``.brdf``) beside it. A kind with a *draft*
+  (:class:`~brdfkit.spec.SpecKind`: a template that compiles nothing — the ``.brdf``
+  and ``.py`` kinds, whose models are then interpreted) is drawn from its draft at
+  once; its real template is resolved in a background thread, one per file content,
+  started once the draft's first views are out (:meth:`FileModels.start_compiles`:
+  Numba's compiler holds the GIL), and evaluated once (the *warm* hook: the views,
+  so Numba compiles their loops); then the file's version is raised
+  (:meth:`FileWatcher.mark`) and the page draws the compiled model, the same values.
+  Compiling fails (a formula Numba cannot type): that content's error, as a broken
+  edit's, and the last compiled version drawn.
 - :func:`check_open` — the "open file" form's path: a file, not a directory, with a
   clear message otherwise.
 
@@ -179,6 +188,15 @@ class FileWatcher:
                 self._polled = now
             return self._version
 
+    def mark(self, path: str) -> int:
+        """Raise the version as for a change of the watched file *path* (what is built
+        from its content changed: its compiled model is ready); the new version."""
+        with self._lock:
+            self._version += 1
+            if path in self._files:
+                self._files[path][2] = self._version
+            return self._version
+
     def changes(self, since: int) -> list[str]:
         """The watched files whose content changed after version *since*."""
         with self._lock:
@@ -189,19 +207,42 @@ def _kind(target):
     return next(k for k in KINDS if k.claims(target))
 
 
+def _interpreted(template) -> bool:
+    return bool(getattr(template, "interpreted", False))
+
+
+def _load(load, target: str):
+    """``load(target)`` (a kind's resolve or draft), or the one-line text of its error."""
+    try:
+        return load(target)
+    except BrdfkitError as exc:
+        return str(exc)
+    except Exception as exc:  # noqa: BLE001 - a user's Python file may raise anything
+        first = next((ln.strip() for ln in str(exc).splitlines() if ln.strip()), "")
+        return f"{target}: {type(exc).__name__}: {first}"
+
+
 class FileModels:
     """Builds file-backed models for one app (module docstring); *opened*: the files
-    the user named on the command line (allowed to run code)."""
+    the user named on the command line (allowed to run code); *warm*: ``warm(model)``
+    evaluates a just-compiled model once (the views it will draw), in the compiling
+    thread."""
 
-    def __init__(self, *, opened=()):
+    def __init__(self, *, opened=(), warm=None):
         self.watcher = FileWatcher()
+        self._warm = warm
         self._lock = threading.Lock()
+        # (target, digest) -> (path, params) of a draft to compile; those started
+        self._pending: dict = {}
+        self._started: set = set()
+        self.threads: list[threading.Thread] = []  # the compiling threads (tests join them)
         self._opened = {os.path.realpath(p) for p in opened}
         # (target, content hash) -> template or the error text of that content: a template
         # holds the file's whole model (a MERL table ~33 MB), a page edits a few files
         self._templates = bounded_cache(None, maxsize=8)
-        # target -> (content hash, template) of its last version that loaded; one per
-        # file-backed target shown (the page has at most 8)
+        # target -> (content hash, template, the entry before it when the template is a
+        # draft) of its last version that loaded; one per file-backed target shown (the
+        # page has at most 8)
         self._good = bounded_cache(None, maxsize=16)
 
     def allow(self, path: str) -> None:
@@ -220,17 +261,52 @@ class FileModels:
         key = (target, digest)
         got = self._templates.get(key)
         if got is None:
-            try:
-                if digest is None:
-                    raise DataFileError(f"{target}: the file cannot be read now (deleted or "
-                                        "being written)")
-                got = _kind(target).resolve(target)
-            except BrdfkitError as exc:
-                got = str(exc)
-            except Exception as exc:  # noqa: BLE001 - a user's Python file may raise anything
-                got = f"{target}: {type(exc).__name__}: {exc}"
+            if digest is None:
+                got = (f"{target}: the file cannot be read now (deleted or being written)")
+            else:
+                kind = _kind(target)
+                got = _load(kind.draft or kind.resolve, target)
             self._templates[key] = got
         return got
+
+    def stage(self, target: str, path: str, digest: str | None) -> str:
+        """What a file content builds now — ``"compiled"``, ``"interpreted"`` (its draft,
+        compiling) or ``"error"`` — loading it if needed (and allowed): a cache key's part."""
+        self._check_allowed(target, path)
+        got = self._template(target, digest)
+        return "error" if isinstance(got, str) else (
+            "interpreted" if _interpreted(got) else "compiled")
+
+    def start_compiles(self) -> None:
+        """Start compiling the drafts built since the last call (module docstring)."""
+        with self._lock:
+            todo = [(k, v) for k, v in self._pending.items() if k not in self._started]
+            self._started.update(k for k, _ in todo)
+            self._pending.clear()
+        for key, (path, params) in todo:
+            t = threading.Thread(target=self._compile, args=(key, path, params), daemon=True,
+                                 name=f"brdfkit compile {os.path.basename(path)}")
+            self.threads = [x for x in self.threads if x.is_alive()] + [t]
+            t.start()
+
+    def _compile(self, key: tuple, path: str, params: dict) -> None:
+        target, digest = key
+        kind = _kind(target)
+
+        def compiled(t):
+            template = kind.resolve(t)
+            if self._warm is not None:
+                self._warm(kind.build(template, params))
+            return template
+
+        got = _load(compiled, target)
+        with self._lock:
+            self._templates[key] = got
+            good = self._good.get(target)
+            if good is not None and good[0] == digest and _interpreted(good[1]):
+                self._good[target] = good[2] if isinstance(got, str) else (digest, got, None)
+            self._started.discard(key)
+        self.watcher.mark(path)
 
     def build(self, target: str, path: str, digest: str | None, params: dict, spec_of) -> tuple:
         """``(model, info)`` of a file-backed target whose file at *path* has the content
@@ -238,8 +314,9 @@ class FileModels:
         (params → :class:`~brdfkit.spec.ModelSpec`) gives the operators. *info*: ``file``
         (path), ``digest`` (12 hex), ``reload_error`` (the new version's error when the
         last good one is drawn, else None), ``dropped`` (parameter names the version does
-        not declare), ``decl`` (the model's description: its parameters). Raises the
-        load error when no version of the file has loaded yet."""
+        not declare), ``decl`` (the model's description: its parameters), ``compiled``
+        (False: the draft, interpreted, its compilation queued). Raises the load error
+        when no version of the file has loaded yet."""
         self._check_allowed(target, path)
         template = self._template(target, digest)
         error = None
@@ -248,17 +325,27 @@ class FileModels:
             good = self._good.get(target)
             if good is None:
                 raise BrdfkitError(error)
-            digest, template = good
+            digest, template, _ = good
         else:
-            self._good[target] = (digest, template)
+            with self._lock:
+                old = self._good.get(target)
+                if old is None or old[0] != digest or old[1] is not template:
+                    before = old if old is None or not _interpreted(old[1]) else old[2]
+                    self._good[target] = (digest, template,
+                                          before if _interpreted(template) else None)
         declared = {p.name for p in template.params}
         if getattr(template, "width_param", None):
             declared.add("beta")  # the half-angle the spec resolves into the width
         kept = {k: v for k, v in params.items() if k in declared}
         spec = spec_of(kept)
+        if _interpreted(template):
+            with self._lock:  # compiled once the draft's views are out (start_compiles)
+                if (target, digest) not in self._started:
+                    self._pending.setdefault((target, digest), (path, dict(spec.params)))
         base = _kind(target).build(template, spec.params)
         m = base
         for op in spec.operators:  # as ModelSpec.build, from the template loaded here
             m = OPERATORS[op.kind].apply(m, op.arguments)
         return m, {"file": path, "digest": (digest or "")[:12], "reload_error": error,
-                   "dropped": sorted(set(params) - declared), "decl": base.describe()}
+                   "dropped": sorted(set(params) - declared), "decl": base.describe(),
+                   "compiled": not _interpreted(template)}

@@ -50,7 +50,7 @@ from __future__ import annotations
 import hashlib
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -314,9 +314,11 @@ def _packer(f: BrdfFile, name: str, coloured: bool):
 _definitions = bounded_cache("brdfkit.user.brdf_file._definitions", maxsize=64)
 
 
-def definition(path, *, bools: dict | None = None):
+def definition(path, *, bools: dict | None = None, compiled: bool = True):
     """The :class:`~brdfkit.user.model.ModelDefinition` of the ``.brdf`` file *path*,
-    with the file's bool parameters at *bools* (default: the file's defaults).
+    with the file's bool parameters at *bools* (default: the file's defaults);
+    *compiled* False: the same definition ``interpreted`` (its models evaluate the
+    kernel's NumPy version; nothing here compiles: Numba compiles on first evaluation).
 
     Read and translated once per file content and bool values (the kernel's compiled
     loops are cached on disk by :mod:`brdfkit.models._drivers`). Raises
@@ -333,7 +335,7 @@ def definition(path, *, bools: dict | None = None):
     key = (f.digest, path, tuple(sorted(flags.items())))
     if key not in _definitions:
         _definitions[key] = _build(f, flags)
-    return _definitions[key]
+    return _definitions[key] if compiled else replace(_definitions[key], interpreted=True)
 
 
 def _build(f: BrdfFile, flags: dict):

@@ -32,6 +32,7 @@ Public objects
 - :class:`SamplerFormulas` — a user's own sampler and pdf, as formulas.
 - :class:`FormulaBRDF` — the model of a definition with parameter values.
 - :func:`packer` — the standard ``pack`` of a definition (declared order, per channel).
+- :func:`interpreted_driver` — a kernel's NumPy version as a pair loop (no compilation).
 - :func:`measure_isotropy` — whether a model is isotropic, numerically.
 - :data:`RECIPROCITY_TOL`, :data:`ISOTROPY_TOL`.
 """
@@ -40,20 +41,20 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from brdfkit._array import as_directions, as_uniform
-from brdfkit._dual import Formulas
+from brdfkit._dual import Formulas, numpy_version
 from brdfkit.data.sampler import TabulatedSampler
 from brdfkit.errors import ParameterError
 from brdfkit.models import DerivedBRDF, Lobe
-from brdfkit.models._drivers import loop_driver
+from brdfkit.models._drivers import UNIT_TOL, loop_driver
 from brdfkit.user._loops import sampler_loops
 
 __all__ = ["ModelDefinition", "SamplerFormulas", "FormulaBRDF", "packer", "measure_isotropy",
-           "RECIPROCITY_TOL", "ISOTROPY_TOL"]
+           "interpreted_driver", "RECIPROCITY_TOL", "ISOTROPY_TOL"]
 
 #: Largest relative asymmetry |f(L,V) − f(V,L)| / max(|f(L,V)|, |f(V,L)|) of a model
 #: measured reciprocal: rounding of a symmetric formula written in another order is ~1e-15.
@@ -160,6 +161,13 @@ class ModelDefinition:
     notes : tuple of str
         One-line remarks the loader makes about the file (e.g. "isFunc section
         ignored: …"), shown by ``describe()`` and ``brdfkit models``.
+    interpreted : bool
+        True: the models built from it evaluate the kernel's NumPy version
+        (:func:`brdfkit._dual.numpy_version`, no compilation; ``kernel`` None on the
+        model, so every engine takes its generic ``model.eval`` path) — what the
+        explorer draws at once after an edit while Numba compiles the kernel
+        (``dataclasses.replace(d, interpreted=True)``). False (the default, what the
+        loaders give): compiled, as every model.
     """
 
     name: str
@@ -181,6 +189,7 @@ class ModelDefinition:
     #: some parameters are compile-time constants of the kernel (a ``.brdf`` file's bools:
     #: each combination has its own kernel); FormulaBRDF builds from it.
     variant: Callable[[dict], ModelDefinition] | None = None
+    interpreted: bool = False
 
 
 # --------------------------------------------------------------------------- packing
@@ -211,6 +220,38 @@ def packer(params, n_channels: int | None = None) -> Callable[[dict], np.ndarray
         return rows
 
     return pack
+
+
+def interpreted_driver(kernel) -> Callable:
+    """``driver(wi, wo, P, out) -> n_bad`` as :func:`~brdfkit.models._drivers.loop_driver`
+    gives, running the NumPy version of the formula *kernel* (:func:`numpy_version`) over
+    all pairs at once: no compilation, the same values (NumPy's IEEE arithmetic, ``select``
+    both sides evaluated as in the compiled loop; libm's exp/log/pow may differ from
+    LLVM's in the last bit). All channels in one pass: a column of the packed rows that is
+    the same in every row is one ``np.float64`` (so a division by 0 is ±inf or NaN, never
+    ``ZeroDivisionError``, and a Python ``if`` on a flag works as compiled), a column that
+    differs a (C, 1) array, so what does not depend on the channel (the geometry) is
+    computed once. Pairs that are not finite unit vectors (|‖w‖² − 1| > UNIT_TOL) are
+    counted and nothing is evaluated (the caller raises). Raises ``TypeError`` when the
+    formula has no NumPy version."""
+    f = numpy_version(kernel)
+
+    def driver(wi, wo, P, out) -> int:
+        norms = (np.einsum("ij,ij->i", wi, wi), np.einsum("ij,ij->i", wo, wo))
+        n_bad = int(np.count_nonzero(~((np.abs(norms[0] - 1.0) <= UNIT_TOL)
+                                       & (np.abs(norms[1] - 1.0) <= UNIT_TOL))))
+        if n_bad:
+            return n_bad
+        args = tuple(np.ascontiguousarray(w[:, k]) for w in (wi, wo) for k in range(3))
+        row = tuple(np.float64(col[0]) if np.all(col == col[0]) else col.reshape(-1, 1)
+                    for col in np.asarray(P, dtype=np.float64).T)
+        with np.errstate(all="ignore"):  # as the compiled loop: IEEE results, no warning
+            f_r = f(*args, row)
+        out[:] = np.broadcast_to(np.asarray(f_r, dtype=np.float64),
+                                 (P.shape[0], out.shape[0])).T
+        return 0
+
+    return driver
 
 
 # --------------------------------------------------------------------------- measurements
@@ -327,7 +368,9 @@ class FormulaBRDF(TabulatedSampler, DerivedBRDF):
     definition's own sampler when it has one, else from its values (the tabulated
     half-vector sampler of :mod:`brdfkit.data.sampler`, χ²-tested). ``to_dict()`` is
     ``{"model": definition.target, "params": ...}``: ``ModelSpec.of(m).build()``
-    rebuilds it from the file.
+    rebuilds it from the file. An *interpreted* definition (``definition.interpreted``)
+    gives a model evaluated by :func:`interpreted_driver` with ``kernel`` None (the same
+    values, not compiled; its user sampler, if any, is still compiled on first use).
     """
 
     def __init__(self, definition: ModelDefinition, /, **values):
@@ -340,15 +383,21 @@ class FormulaBRDF(TabulatedSampler, DerivedBRDF):
             raise ParameterError(f"{definition.name}: unknown parameter {unknown[0]!r}; valid "
                                  "parameters: " + (", ".join(declared) or "none"))
         if definition.variant is not None:  # compile-time parameters: their own kernel
+            interpreted = definition.interpreted
             definition = definition.variant(values)
+            if interpreted and not definition.interpreted:
+                definition = replace(definition, interpreted=True)
         self._definition = definition
         self._measured: dict = {}
         super().__init__(name=definition.name, params=definition.params, values=values,
                          citation=definition.citation, summary=definition.summary,
                          reciprocal=bool(definition.reciprocal), has_sampler=True,
-                         isotropic=definition.isotropic, kernel=definition.kernel)
-        # branch-free and total (a formula): the loop LLVM vectorises, cached on disk
-        self._driver = loop_driver(definition.kernel, loop="vector")
+                         isotropic=definition.isotropic,
+                         kernel=None if definition.interpreted else definition.kernel)
+        # branch-free and total (a formula): the loop LLVM vectorises, cached on disk; or,
+        # interpreted, its NumPy version (kernel None: the engines call eval)
+        self._driver = (interpreted_driver(definition.kernel) if definition.interpreted
+                        else loop_driver(definition.kernel, loop="vector"))
 
     @property
     def definition(self) -> ModelDefinition:

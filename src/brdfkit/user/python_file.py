@@ -16,15 +16,21 @@ tuple there) collected in file order. Each becomes a
   parameters' names (bools as ``p[k] > 0.5``) into the user's formula and makes it
   0 below the horizon, ``select((iz > 0) & (oz > 0), f, 0)``. It is itself a
   formula, so Dr.Jit traces it; the contract of :mod:`brdfkit._dual` is checked when
-  the file is loaded (the error names the function), and the kernel compiled.
+  the file is loaded (the error names the function), and the kernel compiled —
+  unless the definitions are asked for *interpreted* (``compiled=False``: the
+  explorer's first build after an edit): then the kernel's NumPy version
+  (:func:`brdfkit._dual.numpy_version`) is evaluated once instead and the definition
+  is ``interpreted`` (its models are not compiled; a formula calling a primitive with
+  no NumPy version is compiled as usual).
 - **isotropy** — declared (``define(isotropic=...)``) or measured
   (:func:`~brdfkit.user.model.measure_isotropy` at the defaults and two further
   parameter points drawn within the bounds).
 - **sampler** — the user's ``sample``/``pdf`` formulas with their arguments by
   parameter name (colour ones as the channels' mean) or from ``sampler_args``.
 
-Definitions are cached per (path, content hash) in the process: an edited file is
-read again, an unchanged one is not.
+Definitions are cached per (path, content hash, compiled) in the process: an edited
+file is read again, an unchanged one is not (the file's code runs once per content:
+the compiled and the interpreted definitions share its module).
 
 Errors (:class:`~brdfkit.errors.DataFileError` or
 :class:`~brdfkit.errors.UnknownModelError`, one line each, naming the file): no such
@@ -54,7 +60,7 @@ import numba
 import numpy as np
 
 from brdfkit._cache import bounded_cache
-from brdfkit._dual import drjit_version, formula
+from brdfkit._dual import drjit_version, formula, numpy_version
 from brdfkit.errors import BrdfkitError, DataFileError, ParameterError, UnknownModelError
 from brdfkit.formula import Declaration
 from brdfkit.models._drivers import _load
@@ -112,8 +118,9 @@ def _split(spec: str) -> tuple[str, str | None]:
     return spec, None
 
 
-def definition(spec) -> ModelDefinition:
-    """The model definition ``PATH.py`` (the file's one model) or ``PATH.py:NAME`` names.
+def definition(spec, *, compiled: bool = True) -> ModelDefinition:
+    """The model definition ``PATH.py`` (the file's one model) or ``PATH.py:NAME`` names
+    (*compiled* False: interpreted, module docstring).
 
     Raises
     ------
@@ -123,7 +130,7 @@ def definition(spec) -> ModelDefinition:
         Several models and no NAME, or an unknown NAME (the valid names listed).
     """
     path, name = _split(os.fspath(spec).strip())
-    defs = definitions(path)
+    defs = definitions(path, compiled=compiled)
     names = [d.name.rpartition(":")[2] for d in defs]
     if name is None:
         if len(defs) > 1:
@@ -136,9 +143,9 @@ def definition(spec) -> ModelDefinition:
     return defs[names.index(name)]
 
 
-def definitions(path) -> tuple[ModelDefinition, ...]:
+def definitions(path, *, compiled: bool = True) -> tuple[ModelDefinition, ...]:
     """Every model definition the Python file *path* declares, in file order (cached per
-    path and content)."""
+    path, content and *compiled*; False: interpreted, module docstring)."""
     shown = os.fspath(path)
     full = os.path.abspath(os.path.expanduser(shown))
     try:
@@ -150,9 +157,9 @@ def definitions(path) -> tuple[ModelDefinition, ...]:
     except OSError as err:
         raise DataFileError(f"{shown}: cannot be read ({err.strerror})") from None
     digest = hashlib.sha256(full.encode() + b"\0" + data).hexdigest()[:16]
-    key = (full, digest)
+    key = (full, digest, bool(compiled))
     if key not in _DEFINITIONS:
-        _DEFINITIONS[key] = _read(shown, full, digest, data)
+        _DEFINITIONS[key] = _read(shown, full, digest, data, bool(compiled))
     return _DEFINITIONS[key]
 
 
@@ -196,7 +203,8 @@ def _declarations(module) -> list[Declaration]:
     return found
 
 
-def _read(shown: str, full: str, digest: str, data: bytes) -> tuple[ModelDefinition, ...]:
+def _read(shown: str, full: str, digest: str, data: bytes,
+          compiled: bool) -> tuple[ModelDefinition, ...]:
     module = _execute(shown, full, digest, data)
     decls = _declarations(module)
     if not decls:
@@ -207,9 +215,10 @@ def _read(shown: str, full: str, digest: str, data: bytes) -> tuple[ModelDefinit
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise DataFileError(f"{shown}: declares the model {twice[0]!r} twice")
-    formulas: dict = {}
-    module.__brdfkit_formulas__ = formulas  # what the generated kernels read
-    return tuple(_definition(shown, full, module, d, formulas) for d in decls)
+    # what the generated kernels read (one dict per module: a second read of the same
+    # content, compiled after interpreted, finds the kernels already importing it)
+    formulas: dict = vars(module).setdefault("__brdfkit_formulas__", {})
+    return tuple(_definition(shown, full, module, d, formulas, compiled) for d in decls)
 
 
 def _as_formula(f):
@@ -238,8 +247,8 @@ def _arguments(label: str, role: str, f, leading: tuple, params: dict) -> list[s
     return rest
 
 
-def _definition(shown: str, full: str, module, decl: Declaration,
-                formulas: dict) -> ModelDefinition:
+def _definition(shown: str, full: str, module, decl: Declaration, formulas: dict,
+                compiled: bool = True) -> ModelDefinition:
     label = f"{shown}: model {decl.name!r}"
     params = {p.name: p for p in decl.params}
     columns = {p.name: k for k, p in enumerate(decl.params)}
@@ -283,7 +292,8 @@ def _definition(shown: str, full: str, module, decl: Declaration,
         sampler = SamplerFormulas(sample=generated.sample, pdf=generated.pdf,
                                   args=_args_builder(label, decl, sampler_names, kinds))
     pack = packer(decl.params)
-    _check(label, kernel, sampler, pack, decl)
+    interpreted = not compiled and _interpretable(kernel)
+    _check(label, kernel, sampler, pack, decl, compile=not interpreted)
     target = f"{full}:{decl.name}"
     d = ModelDefinition(
         name=f"{os.path.basename(full)}:{decl.name}", source=full, target=target,
@@ -291,8 +301,9 @@ def _definition(shown: str, full: str, module, decl: Declaration,
         isotropic=bool(decl.isotropic), reciprocal=decl.reciprocal,
         energy_conserving=decl.energy_conserving, sampler=sampler,
         citation=decl.citation, summary=decl.summary,
-        isotropy_reason="declared by the file (define(isotropic=...))")
-    if decl.isotropic is None:
+        isotropy_reason="declared by the file (define(isotropic=...))",
+        interpreted=interpreted)
+    if decl.isotropic is None:  # measured with the definition's own models (interpreted too)
         iso = all(measure_isotropy(FormulaBRDF(d, **values))
                   for values in _parameter_points(decl.params))
         d = replace(d, isotropic=iso, isotropy_reason=(
@@ -331,9 +342,19 @@ def _args_builder(label: str, decl: Declaration, names: list, kinds: dict):
     return args
 
 
-def _check(label: str, kernel, sampler, pack, decl: Declaration) -> None:
+def _interpretable(kernel) -> bool:
+    """Whether the kernel has a NumPy version (every primitive it calls has one)."""
+    try:
+        numpy_version(kernel)
+    except TypeError:
+        return False
+    return True
+
+
+def _check(label: str, kernel, sampler, pack, decl: Declaration, *, compile: bool) -> None:
     """The contract of brdfkit._dual (Dr.Jit's version built: names the function at fault)
-    and a first compilation of each formula (Numba's error, first line)."""
+    and a first compilation of each formula (Numba's error, first line); not *compile*:
+    the kernel's NumPy version evaluated once instead (its error, first line)."""
     if importlib.util.find_spec("drjit") is not None:
         for f in (kernel,) if sampler is None else (kernel, sampler.sample, sampler.pdf):
             try:
@@ -342,6 +363,17 @@ def _check(label: str, kernel, sampler, pack, decl: Declaration) -> None:
                 raise DataFileError(f"{label}: {err}") from None
     defaults = {p.name: p.validate(p.default, label) for p in decl.params}
     row = np.ascontiguousarray(pack(defaults)[0])
+    if not compile:
+        one, zero = np.ones(1), np.zeros(1)
+        try:
+            with np.errstate(all="ignore"):
+                numpy_version(kernel)(zero, zero, one, zero, zero, one,
+                                      tuple(np.float64(x) for x in row))
+        except Exception as err:  # noqa: BLE001 - the user's formula, reported
+            first = next((ln.strip() for ln in str(err).splitlines() if ln.strip()), "")
+            raise DataFileError(f"{label}: the eval formula fails: {type(err).__name__}: "
+                                f"{first}") from None
+        return
     calls = [("eval", lambda: kernel(0.0, 0.0, 1.0, 0.0, 0.0, 1.0, row))]
     if sampler is not None:
         a = sampler.args(defaults)

@@ -12,7 +12,8 @@ let lastViews = null;
 let lobeView = { yaw: -0.6, pitch: 0.5 };
 let pending = null;
 let inflight = false;
-// spec -> {file, digest, decl, reload_error, reloaded}: what the server said of a file model
+// spec -> {file, digest, decl, reload_error, reloaded, compiled}: what the server said of a
+// file model (compiled false: its interpreted draft, drawn while the server compiles it)
 const fileInfo = {};
 // Watched files are polled, not pushed (server-sent events): a poll every 100 ms (a stat
 // per shown file, ~1 ms a request) keeps a saved edit well under a second away (poll +
@@ -193,7 +194,8 @@ function renderModelList() {
       const file = document.createElement("div");
       file.className = "file"; file.id = "model-file-" + i;
       file.textContent = "file " + info.file + (info.digest ? " · " + info.digest : "") +
-        (info.reloaded ? " · reloaded " + info.reloaded : "");
+        (info.reloaded ? " · reloaded " + info.reloaded : "") +
+        (info.compiled === false ? " · interpreted (compiling…)" : "");
       box.appendChild(file);
     }
     const decl = declFor(entry);
@@ -456,9 +458,10 @@ function takeFileInfo(models, index) {
     const entry = state.models[index[k]];
     const old = fileInfo[v.spec] || {};
     const info = { file: v.file, digest: v.digest, decl: v.decl || old.decl,
-                   reload_error: v.reload_error, reloaded: old.reloaded };
+                   reload_error: v.reload_error, reloaded: old.reloaded, compiled: v.compiled };
     if (old.digest && v.digest && old.digest !== v.digest) info.reloaded = new Date().toLocaleTimeString();
-    if (JSON.stringify(info.decl) !== JSON.stringify(old.decl) || info.digest !== old.digest) relist = true;
+    if (JSON.stringify(info.decl) !== JSON.stringify(old.decl) || info.digest !== old.digest ||
+        info.compiled !== old.compiled) relist = true;
     fileInfo[v.spec] = info;
     for (const name of v.dropped || []) {
       if (entry && name in entry.params) {
