@@ -28,3 +28,7 @@ def _random_hemisphere(rng: np.random.Generator, n: int) -> np.ndarray:
 @pytest.fixture
 def random_hemisphere():
     return _random_hemisphere
+
+
+# the explorer's browser tests: a live server and headless Chromium (module-scoped)
+from explorer_harness import browser, server  # noqa: E402, F401

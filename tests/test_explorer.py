@@ -14,19 +14,15 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
 import socket
-import threading
-import time
 import urllib.parse
 
 import numpy as np
 import pytest
+from explorer_harness import open_page, wait_ready
 
 import brdfkit
 from brdfkit.explorer import views
-
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
 
 # --------------------------------------------------------------------------- views
@@ -107,62 +103,6 @@ def test_api_export_binary(client, tmp_path):
 
 
 # --------------------------------------------------------------------------- the browser
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-@pytest.fixture(scope="module")
-def server():
-    import uvicorn
-
-    from brdfkit.explorer.app import create_app
-
-    port = _free_port()
-    srv = uvicorn.Server(uvicorn.Config(create_app(), host="127.0.0.1", port=port,
-                                        log_level="warning"))
-    thread = threading.Thread(target=srv.run, daemon=True)
-    thread.start()
-    for _ in range(200):
-        if srv.started:
-            break
-        time.sleep(0.05)
-    yield f"http://127.0.0.1:{port}/"
-    srv.should_exit = True
-    thread.join(timeout=10)
-
-
-@pytest.fixture(scope="module")
-def browser():
-    if CHROMIUM is None:
-        pytest.skip("no chromium on this machine: scripts/setup.sh --test installs it with "
-                    "apt-get when run as root (apt-get install chromium)")
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=[
-            "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-            "--disable-component-update", "--disable-sync", "--no-first-run"])
-        yield b
-        b.close()
-
-
-def _open(browser, url):
-    page = browser.new_page(viewport={"width": 1300, "height": 1000})
-    errors = []
-    page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
-    page.on("pageerror", lambda e: errors.append(str(e)))
-    page.goto(url)
-    _wait_ready(page)
-    return page, errors
-
-
-def _wait_ready(page):
-    page.wait_for_function("document.getElementById('status').textContent === 'ready'",
-                           timeout=180_000)
-
-
 def _url(base, models, **extra):
     return base + "#" + urllib.parse.quote(json.dumps({"models": models, **extra}))
 
@@ -178,7 +118,7 @@ def _informative(png: bytes) -> bool:
 
 
 def test_page_loads_and_updates(browser, server, tmp_path):
-    page, errors = _open(browser, _url(server, [{"spec": "modified-phong", "params": {}}]))
+    page, errors = open_page(browser, _url(server, [{"spec": "modified-phong", "params": {}}]))
     assert errors == []
     sphere0 = page.locator("#spheres img").first.get_attribute("src")
     albedo0 = page.evaluate("document.getElementById('albedo').toDataURL()")
@@ -187,13 +127,13 @@ def test_page_loads_and_updates(browser, server, tmp_path):
     n.dispatch_event("change")
     page.wait_for_function(f"document.querySelector('#spheres img').src !== {sphere0!r}",
                            timeout=120_000)
-    _wait_ready(page)
+    wait_ready(page)
     albedo1 = page.evaluate("document.getElementById('albedo').toDataURL()")
     assert albedo1 != albedo0  # the albedo curve moved with n
     # the state is in the URL: a new page at that URL restores n = 200
     shared = page.url
     assert "200" in urllib.parse.unquote(shared)
-    page2, errors2 = _open(browser, shared)
+    page2, errors2 = open_page(browser, shared)
     assert page2.locator("#model-list input[data-param='n']").first.input_value() == "200"
     assert errors2 == [] and errors == []
     # every view has content
@@ -205,7 +145,7 @@ def test_page_loads_and_updates(browser, server, tmp_path):
 
 
 def test_page_shows_a_diverging_verdict_and_bad_input(browser, server):
-    page, errors = _open(browser, _url(server, [{"spec": "ward", "params": {}}]))
+    page, errors = open_page(browser, _url(server, [{"spec": "ward", "params": {}}]))
     page.wait_for_function("document.getElementById('verdicts').textContent.includes('diverges')",
                            timeout=180_000)
     assert "ward" in page.locator("#verdicts").text_content()
@@ -230,13 +170,13 @@ def test_page_fits_a_model_to_a_material(browser, server):
 
     path = Path(tempfile.mkdtemp()) / "lambert03.binary"
     export_merl(brdfkit.model("lambert", rho_d=0.3), path)
-    page, errors = _open(browser, _url(server, [{"spec": str(path), "params": {}},
+    page, errors = open_page(browser, _url(server, [{"spec": str(path), "params": {}},
                                                 {"spec": "lambert", "params": {}}]))
     assert page.locator("#fit-target").input_value() == str(path)
     page.click("#fit-button")
     page.wait_for_function("document.getElementById('fit-status').textContent"
                            ".startsWith('fitted in')", timeout=120_000)
-    _wait_ready(page)
+    wait_ready(page)
     fitted = page.locator("#model-list .model").nth(2).locator("input[data-param='rho_d']")
     rho = [float(x) for x in fitted.first.input_value().split(",")]
     np.testing.assert_allclose(rho, 0.3, rtol=1e-3)

@@ -23,20 +23,17 @@ import json
 import math
 import os
 import re
-import shutil
-import socket
-import threading
 import time
 import urllib.parse
 
 import numpy as np
 import pytest
+from explorer_harness import free_port, open_page
 
 import brdfkit
 from brdfkit.data.export import export_merl
 from brdfkit.explorer import files
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 LOCAL = {"client": ("127.0.0.1", 50000), "headers": {"host": "127.0.0.1:8765"}}
 
 LAMBERT_BRDF = """analytic
@@ -270,62 +267,6 @@ def test_api_python_file_reload(tmp_path):
 
 
 # --------------------------------------------------------------------------- the browser
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-@pytest.fixture(scope="module")
-def server():
-    import uvicorn
-
-    from brdfkit.explorer.app import create_app
-
-    port = _free_port()
-    srv = uvicorn.Server(uvicorn.Config(create_app(), host="127.0.0.1", port=port,
-                                        log_level="warning"))
-    thread = threading.Thread(target=srv.run, daemon=True)
-    thread.start()
-    for _ in range(200):
-        if srv.started:
-            break
-        time.sleep(0.05)
-    yield f"http://127.0.0.1:{port}/"
-    srv.should_exit = True
-    thread.join(timeout=10)
-
-
-@pytest.fixture(scope="module")
-def browser():
-    if CHROMIUM is None:
-        pytest.skip("no chromium on this machine: scripts/setup.sh --test installs it with "
-                    "apt-get when run as root (apt-get install chromium)")
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=[
-            "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-            "--disable-component-update", "--disable-sync", "--no-first-run"])
-        yield b
-        b.close()
-
-
-def _open(browser, url):
-    page = browser.new_page(viewport={"width": 1400, "height": 1000})
-    errors = []
-    page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
-    page.on("pageerror", lambda e: errors.append(str(e)))
-    page.goto(url)
-    _wait_ready(page)
-    return page, errors
-
-
-def _wait_ready(page):
-    page.wait_for_function("document.getElementById('status').textContent === 'ready'",
-                           timeout=180_000)
-
-
 def _url(base, specs):
     models = [{"spec": s, "params": {}, "pump": None, "times": 1, "visible": True} for s in specs]
     return base + "#" + urllib.parse.quote(json.dumps({"models": models}))
@@ -351,7 +292,7 @@ def _wait_value(page, k: int, want: float, timeout_ms: int) -> float:
 def test_page_reloads_a_saved_file_within_a_second(browser, server, tmp_path):
     p = tmp_path / "lam.binary"
     _lambert_binary(p, 0.3)
-    page, errors = _open(browser, _url(server, [str(p)]))
+    page, errors = open_page(browser, _url(server, [str(p)]))
     _wait_value(page, 0, 0.3 / math.pi, 10_000)
     assert str(p) in page.locator("#model-file-0").text_content()
     latencies = []
@@ -397,7 +338,7 @@ def test_page_reloads_a_saved_file_within_a_second(browser, server, tmp_path):
 def test_page_opens_a_file_by_path(browser, server, tmp_path):
     p = tmp_path / "lam.binary"
     _lambert_binary(p, 0.35)
-    page, errors = _open(browser, _url(server, ["lambert"]))
+    page, errors = open_page(browser, _url(server, ["lambert"]))
     for path, says in ((str(tmp_path), "is a directory"), (str(tmp_path / "nope.brdf"),
                                                           "no such file")):
         page.fill("#open-path", path)
@@ -428,7 +369,7 @@ def test_page_brdf_file_live(browser, server, tmp_path):
     pytest.importorskip("brdfkit.user.brdf_file")
     p = tmp_path / "lambert.brdf"
     p.write_text(LAMBERT_BRDF)
-    page, errors = _open(browser, _url(server, [str(p)]))
+    page, errors = open_page(browser, _url(server, [str(p)]))
     _wait_value(page, 0, 0.5 / math.pi, 60_000)
     assert page.locator("#model-list input[data-param='rho']").count() >= 1
     t0 = time.perf_counter()
@@ -458,7 +399,7 @@ def test_page_brdf_bool_is_a_checkbox(browser, server, tmp_path):
     p = tmp_path / "doubled.brdf"
     p.write_text(LAMBERT_BRDF.replace("float rho 0 1 0.5", "float rho 0 1 0.5\nbool doubled 0")
                  .replace("vec3(rho", "vec3((doubled ? 2.0 : 1.0) * rho"))
-    page, errors = _open(browser, _url(server, [str(p)]))
+    page, errors = open_page(browser, _url(server, [str(p)]))
     _wait_value(page, 0, 0.5 / math.pi, 60_000)
     box = page.locator("#model-list input[type=checkbox][data-param='doubled']")
     assert box.count() == 1 and not box.is_checked()
@@ -474,7 +415,7 @@ def test_page_python_file_opened_by_path_and_live(browser, server, tmp_path):
     pytest.importorskip("brdfkit.user.python_file")
     py = tmp_path / "lam.py"
     py.write_text(LAMBERT_PY.format(scale=1.0, name="rho"))
-    page, errors = _open(browser, _url(server, [str(py)]))
+    page, errors = open_page(browser, _url(server, [str(py)]))
     assert "a link cannot open it" in page.locator("#model-error-0").text_content()
     page.fill("#open-path", str(py))
     page.click("#open-button")
@@ -501,7 +442,7 @@ def test_explore_command_serves_file_specs(tmp_path):
     a, b = tmp_path / "a.binary", tmp_path / "b.binary"
     _lambert_binary(a, 0.3)
     _lambert_binary(b, 0.6)
-    port = _free_port()
+    port = free_port()
     proc = subprocess.Popen([sys.executable, "-m", "brdfkit", "explore", "--no-browser",
                              "--port", str(port), "a.binary", str(b)], cwd=tmp_path,
                             stderr=subprocess.PIPE, text=True)
@@ -683,7 +624,7 @@ def test_page_formula_edit_within_a_second(browser, server, tmp_path):
     p.write_text(_scaled_principled(1.0))
     py = tmp_path / "lam.py"
     py.write_text(LAMBERT_PY.format(scale=1.0, name="rho"))
-    page, errors = _open(browser, _url(server, [str(p)]))
+    page, errors = open_page(browser, _url(server, [str(p)]))
     page.wait_for_function(f"(({SLICE0})(0)) > 0", timeout=120_000)
     page.fill("#open-path", str(py))
     page.click("#open-button")
