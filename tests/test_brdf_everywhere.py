@@ -127,7 +127,7 @@ def oren_nayar_qualitative(sigma_deg, wi, wo):
 def test_eval_bool_parameter_switches_the_formula():
     rho = np.array([0.75, 0.75, 0.75]) / math.pi
     for wi, wo in (((50, 10), (30, 40)), ((50, 0), (30, 180))):
-        args = ("--wi", "%g,%g" % wi, "--wo", "%g,%g" % wo)
+        args = ("--wi", f"{wi[0]},{wi[1]}", "--wo", f"{wo[0]},{wo[1]}")
         want = oren_nayar_qualitative(30.0, direction(*wi), direction(*wo)) * rho
         on = ok_json("eval", OREN_NAYAR, "-p", "sigma=30", "-p", "qualitative=true", *args)
         assert on["params"]["qualitative"] is True
