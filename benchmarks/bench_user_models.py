@@ -31,9 +31,9 @@ the built-in (median 1.245: over the 1.2 target), the same formula in a Python f
 1.20-1.23×; the ``.brdf`` with the built-in's arithmetic 1.04, 1.00, 1.02× (values equal
 to 1.1e-15). The translation adds nothing (its generated kernel is the file's arithmetic,
 interned, in order): the corpus file's formula costs 7 divisions and 3 square roots per
-pair where the built-in's has 4 and 2 (``normalize``, G₁ through tan²θ, the final
-1/(4 N·L N·V)); the translator keeps GLSL's operations as written (float32 agreement
-with a GPU), so the ratio is the file's.
+pair (``normalize``, G₁ through tan²θ twice, the final 1/(4 N·L N·V)) where the built-in
+shares one 1/|s|² and takes G₁/cos θ; the translator keeps GLSL's operations as written
+(float32 agreement with a GPU), so the ratio is the file's formula's.
 
 Usage::
 
