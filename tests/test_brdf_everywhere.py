@@ -14,7 +14,8 @@ References, independent of the code under test:
   written here against the registered ``modified-phong``: its fit to a MERL material;
 - **Ward's formula written in the test** (Walter's 2005 notes on the Ward BRDF, eq. 5a
   form) integrated by a product Gauss–Legendre × trapezoid rule: the anisotropic file's
-  albedo at two incidence azimuths through ``albedo --phi``;
+  albedo at two incidence azimuths through ``albedo --phi``; its 1/√(cos θ_i cos θ_o)
+  makes the albedo diverge as (cos θ_i)^(−1/2) at grazing incidence (``check --phi``);
 - **the file's own text**: the line:col that ``brdfkit models`` gives for reading X holds
   an ``X``; the declared ranges bound the fitted values.
 """
@@ -203,12 +204,15 @@ def test_check_and_table2_of_the_walter_file():
 
 
 def test_check_phi_of_the_anisotropic_file():
-    d = ok_json("check", WARD, "--phi", "90")
-    assert d["phi_deg"] == 90.0 and d["reciprocity"] == "reciprocal"
-    # Ward's normalisation is not energy conserving at grazing incidence either way;
-    # the verdict's maximum is at least the albedo at 60° computed above
-    assert d["max_albedo"] >= ward_albedo(math.radians(60.0), math.pi / 2, ax=0.4, ay=0.15,
-                                          rho_d=0.1, rho_s=0.6) - 1e-6
+    at = {phi: ok_json("check", WARD, "--phi", phi) for phi in (0.0, 90.0)}
+    for phi, d in at.items():
+        assert d["phi_deg"] == phi and d["reciprocity"] == "reciprocal"
+        # Ward's 1/√(cos θ_i cos θ_o): the specular albedo grows as (cos θ_i)^(-1/2) at
+        # grazing incidence (the rest of the integrand stays bounded), measured toward 1/2
+        assert d["energy"] == "diverges"
+        assert 0.4 < d["divergence_exponent"] <= 0.5
+    # the lobe's ellipse: light along X or along Y reflects differently at grazing
+    assert at[0.0]["max_albedo"] > 2.0 * at[90.0]["max_albedo"]
 
 
 # --------------------------------------------------------------------------- figure, export
@@ -303,6 +307,10 @@ def test_pumping_a_file_is_pumping_the_registered_model(tmp_path):
     np.testing.assert_allclose(np.load(a), np.load(b), rtol=1e-6, atol=1e-12)
     out = tmp_path / "p.png"
     assert run("figure", "slices", "--model", WALTER, "--pump", "max", "--out", out).exit_code == 0
+    x1, x2 = (ok_json("export", *m, "--out", tmp_path / f"{k}.binary")
+              for k, m in (("a", ours_m), ("b", theirs_m)))
+    assert x1["pump"] == {"g": "max", "times": 1}
+    np.testing.assert_allclose(x1["normal_albedo"], x2["normal_albedo"], rtol=1e-6)
 
 
 def test_pumping_the_anisotropic_file_is_one_error_line():
