@@ -17,9 +17,10 @@ test configuration, Φ_L = 45°, E = 1, L_a = 0.2, ``path`` with max_depth 2, S�
   gives a coloured ``.brdf``: every row holds all three channels' η, κ and the channel
   index, the kernel computes F·D·G for r, g and b and keeps the row's with
   ``select(p[K-1] == 0.0, r, select(p[K-1] == 1.0, g, b))``;
-- rows from :func:`extra_models` (the ``.brdf`` file of Walter GGX: the coordinator adds
-  it there — a function taking nothing, returning ``[(name, model), …]``; each model goes
-  through :func:`traced_row`);
+- rows from :func:`extra_models`: ``built-in microfacet GGX, F = 1 (traced)`` and
+  ``walter_ggx.brdf, F = 1 (traced)``, the corpus file ``tests/brdf_files/walter_ggx.brdf``
+  at α = 0.2 (no Fresnel factor: timed and compared against the F = 1 built-in,
+  :data:`BASELINES`), each through :func:`traced_row`;
 - ``roughconductor (Mitsuba, symbolic)``: Mitsuba's own, for scale.
 
 Each row: median of ``--repeats`` renders after one warm-up render (kernel compilation),
@@ -40,7 +41,11 @@ Measured (2-core "Intel(R) Xeon(R) Processor" of lscpu, shared, load average 4-6
     user-like GGX, channel index (traced)      0.96  1.04  0.99  0.98  0.98  | 512²: 0.95
     roughconductor (Mitsuba, symbolic)         0.92  1.00  0.91  0.89  1.03  | 512²: 0.90
 
-(median render 0.11-0.23 s under that load). The images agree (|z| < 1). Timed row after
+(median render 0.11-0.23 s under that load). The ``.brdf`` row (issue 21 §3), against
+the F = 1 built-in (same machine, load average 1.2-1.5; three runs at 256², 9 and 15
+rounds, one at 512²): paired ratio 1.01, 1.01 | 512²: 1.02 (target ≤ 1.5); the F = 1
+built-in itself reads 0.87-0.89 of the conductor row, the file 0.89-1.02 of it; the
+file's image agrees with the F = 1 built-in's (z = −0.28). The images agree (|z| < 1). Timed row after
 row instead (``time_rows`` of ``bench_render_mitsuba``), the rows drift with the others'
 jobs: the built-in row timed twice in one run read 1.00 and 1.17, and one early run at
 ~0.04 s per render read 1.40 and 1.88 for the two user rows — hence the interleaved
@@ -115,11 +120,23 @@ def user_models() -> list[tuple[str, BRDF]]:
              UserLike(kernel=user_walter_indexed, packed=rows))]
 
 
+#: The corpus file of Walter GGX with Smith G1, F = 1 (tests/brdf_files/walter_ggx.brdf).
+WALTER_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "tests",
+                           "brdf_files", "walter_ggx.brdf")
+#: Rows timed against another row than the first (row name -> baseline row name): ratios
+#: and image agreement. The ``.brdf`` file has no Fresnel factor, so its baseline is the
+#: built-in microfacet without one, not the conductor of the first row.
+BASELINES = {"walter_ggx.brdf, F = 1 (traced)": "built-in microfacet GGX, F = 1 (traced)"}
+
+
 def extra_models() -> list[tuple[str, BRDF]]:
-    """More user models to time, ``[(row name, model), …]`` — the place for the ``.brdf``
-    file of Walter GGX, e.g. ``[("walter_ggx.brdf (traced)", brdfkit.model(PATH,
-    alpha=0.2, …))]`` (the coordinator adds it)."""
-    return []
+    """More user models to time, ``[(row name, model), …]``: the ``.brdf`` file of Walter
+    GGX at α = 0.2 (its own FormulaBRDF: the GLSL translated, the proxy sampler of its
+    measured lobe) and its baseline, the built-in ``microfacet`` with F = 1."""
+    return [("built-in microfacet GGX, F = 1 (traced)",
+             brdfkit.model("microfacet", distribution="ggx", alpha=ALPHA)),
+            ("walter_ggx.brdf, F = 1 (traced)",
+             brdfkit.model(os.path.normpath(WALTER_FILE), alpha=ALPHA))]
 
 
 def traced_row(name: str, model: BRDF):
@@ -194,22 +211,27 @@ def time_interleaved(mi, rows, variant, args) -> dict:
 
 def report(results, variant, args) -> None:
     names = list(results)
-    base_t, base_i = results[names[0]]
+
+    def base(name):
+        return BASELINES.get(name, names[0])
+
     print(f"\n{variant}: {args.size}² pixels, {args.spp} spp, {args.repeats} rounds "
           "(rows interleaved)")
-    print(f"{'renderer':42s} {'median s':>9s} {'ratio':>7s} {'paired':>7s}")
+    print(f"{'renderer':42s} {'median s':>9s} {'ratio':>7s} {'paired':>7s}  baseline")
     for name in names:
-        t = results[name][0]
-        print(f"{name:42s} {np.median(t):9.4f} {np.median(t) / np.median(base_t):7.2f} "
-              f"{np.median(t / base_t):7.2f}")
+        t, bt = results[name][0], results[base(name)][0]
+        print(f"{name:42s} {np.median(t):9.4f} {np.median(t) / np.median(bt):7.2f} "
+              f"{np.median(t / bt):7.2f}  {'' if base(name) == names[0] else base(name)}")
     print("ratio: of the medians; paired: the median over the rounds of the ratio to the "
-          "first row in the same round")
+          "baseline row (the first unless named) in the same round")
     for name in names[1:]:  # agreement: the image sums within 3 standard errors
-        ia = results[name][1]
-        d = ia.mean(axis=0) - base_i.mean(axis=0)
-        var = (ia.var(axis=0, ddof=1) + base_i.var(axis=0, ddof=1)) / args.repeats
+        ia, ib = results[name][1], results[base(name)][1]
+        if name in BASELINES.values():
+            continue  # a baseline itself: another formula than the first row's
+        d = ia.mean(axis=0) - ib.mean(axis=0)
+        var = (ia.var(axis=0, ddof=1) + ib.var(axis=0, ddof=1)) / args.repeats
         z = d.sum() / math.sqrt(var.sum()) if var.sum() > 0.0 else 0.0
-        print(f"agreement {name} vs {names[0]}: mean difference {d.mean():+.2e}, "
+        print(f"agreement {name} vs {base(name)}: mean difference {d.mean():+.2e}, "
               f"z = {z:+.2f}{'' if abs(z) < 3 else '  <-- DISAGREE'}")
 
 
