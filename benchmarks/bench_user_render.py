@@ -46,7 +46,8 @@ the F = 1 built-in (same machine, load average 1.2-1.5; three runs at 256², 9 a
 rounds, one at 512²): paired ratio 1.01, 1.01 | 512²: 1.02 (target ≤ 1.5); the F = 1
 built-in itself reads 0.87-0.89 of the conductor row, the file 0.89-1.02 of it; the
 file's image agrees with the F = 1 built-in's (z = −0.28). The images agree (|z| < 1).
-Timed row after row instead (``time_rows`` of ``bench_render_mitsuba``), the rows drift with the others'
+Timed row after row instead (``time_rows`` of ``bench_render_mitsuba``), the rows drift with the
+others'
 jobs: the built-in row timed twice in one run read 1.00 and 1.17, and one early run at
 ~0.04 s per render read 1.40 and 1.88 for the two user rows — hence the interleaved
 rounds and the paired ratio.
