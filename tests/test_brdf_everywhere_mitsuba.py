@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import gc
 import math
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -120,41 +119,10 @@ def test_chi2_rejects_the_wrong_density():
 mi = pytest.importorskip("mitsuba")
 dr = pytest.importorskip("drjit")
 
-from brdfkit.render.mitsuba_bridge import mitsuba_bsdf, use_variant  # noqa: E402
+from test_user_traced import _directions, _llvm, _si  # noqa: E402 (the traced route's harness)
+
+from brdfkit.render.mitsuba_bridge import mitsuba_bsdf  # noqa: E402
 from brdfkit.render.mitsuba_sphere import sphere_scene  # noqa: E402
-
-
-def _llvm(name: str) -> str:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        variant = use_variant(name)
-    if not variant.startswith("llvm"):
-        pytest.skip(f"the traced route needs an llvm variant ({name} fell back to {variant})")
-    return variant
-
-
-def _pairs(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
-    """(view, light) float32-exact unit vectors, half the lights near the view's mirror."""
-    rng = np.random.default_rng(seed)
-
-    def hemi():
-        z = rng.uniform(0.05, 1.0, n)
-        ph = rng.uniform(0.0, 2.0 * math.pi, n)
-        s = np.sqrt(1.0 - z * z)
-        return np.stack([s * np.cos(ph), s * np.sin(ph), z], -1)
-
-    view, light = hemi(), hemi()
-    light[: n // 2] = view[: n // 2] * [-1.0, -1.0, 1.0] + rng.normal(scale=0.1, size=(n // 2, 3))
-    light[:, 2] = np.abs(light[:, 2]) + 0.02
-    light /= np.linalg.norm(light, axis=-1, keepdims=True)
-    return view.astype(np.float32).astype(float), light.astype(np.float32).astype(float)
-
-
-def _si(view):
-    si = dr.zeros(mi.SurfaceInteraction3f, view.shape[0])
-    si.wi = mi.Vector3f(view.T.astype(np.float32))
-    return si
-
 
 MODELS = {"walter": lambda: brdfkit.model(str(WALTER), alpha=0.3),
           "cook-torrance": lambda: brdfkit.model(str(COOK_TORRANCE), m=0.3,
@@ -168,7 +136,7 @@ def test_traced_file_pointwise(which):
     bsdf = mitsuba_bsdf(model)  # no route forced: a file's model takes the traced one
     assert bsdf.traced
     n = 256
-    view, light = _pairs(n, 3)
+    view, light = _directions(np.random.default_rng(3), n)
     ctx, si, wo = mi.BSDFContext(), _si(view), mi.Vector3f(light.T.astype(np.float32))
     got = np.array(bsdf.eval(ctx, si, wo)).T
     f = np.asarray(model.eval(light, view)).reshape(n, -1)
@@ -230,7 +198,7 @@ def test_scene_dict_plugin_takes_a_file():
     cases = [({"model": str(WALTER), "alpha": 0.3}, {"alpha": 0.3}),
              ({"model": str(COOK_TORRANCE), "m": 0.3, "base": "0.9, 0.5, 0.2"},
               {"m": 0.3, "base": [0.9, 0.5, 0.2]})]
-    view, light = _pairs(32, 5)
+    view, light = _directions(np.random.default_rng(5), 32)
     for props, values in cases:
         bsdf = mi.load_dict({"type": "brdfkit", **props})
         assert bsdf.traced
