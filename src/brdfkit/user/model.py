@@ -31,7 +31,6 @@ Public objects
 - :class:`ModelDefinition` — the one description of a user model.
 - :class:`SamplerFormulas` — a user's own sampler and pdf, as formulas.
 - :class:`FormulaBRDF` — the model of a definition with parameter values.
-- :func:`packer` — the standard ``pack`` of a definition (declared order, per channel).
 - :func:`interpreted_driver` — a kernel's NumPy version as a pair loop (no compilation).
 - :func:`measure_isotropy` — whether a model is isotropic, numerically.
 - :data:`RECIPROCITY_TOL`, :data:`ISOTROPY_TOL`.
@@ -53,7 +52,7 @@ from brdfkit.models import DerivedBRDF, Lobe
 from brdfkit.models._drivers import UNIT_TOL, loop_driver
 from brdfkit.user._loops import sampler_loops
 
-__all__ = ["ModelDefinition", "SamplerFormulas", "FormulaBRDF", "packer", "measure_isotropy",
+__all__ = ["ModelDefinition", "SamplerFormulas", "FormulaBRDF", "measure_isotropy",
            "interpreted_driver", "RECIPROCITY_TOL", "ISOTROPY_TOL"]
 
 #: Largest relative asymmetry |f(L,V) − f(V,L)| / max(|f(L,V)|, |f(V,L)|) of a model
@@ -128,13 +127,13 @@ class ModelDefinition:
         :func:`brdfkit.models._drivers._load`), so that its compiled pair loop is
         cached on disk; and it must keep the :mod:`brdfkit._dual` contract, so that
         ``drjit_version(kernel)`` traces it for Mitsuba.
-    pack : callable
+    pack : callable or None
         ``pack(values) -> ndarray float64 (C, K)``: the validated values dict (NAME →
         float, per-channel float array, bool, or choice string, as ``Param.validate``
         returns them) → the kernel's packed rows, one row per channel (C = 1 for a
-        grey model). Row c holds channel c of every colour parameter (a scalar colour
-        value repeated) and every other parameter as is (bool → 1.0/0.0, a choice →
-        its index).
+        grey model). None: the packing of every model (:meth:`BRDF._pack`: one column
+        per parameter in declared order, row c holding channel c of every colour
+        parameter — a scalar colour value repeated — bools 1.0/0.0, a choice its index).
     n_channels : int or None
         None: the model is grey unless a colour parameter is given per channel, and
         then has that many channels (as built-in models: counted from the values).
@@ -175,7 +174,7 @@ class ModelDefinition:
     target: str
     params: tuple
     kernel: Callable
-    pack: Callable[[dict], object]
+    pack: Callable[[dict], object] | None
     n_channels: int | None = None
     isotropic: bool = True
     isotropy_reason: str = ""
@@ -192,36 +191,7 @@ class ModelDefinition:
     interpreted: bool = False
 
 
-# --------------------------------------------------------------------------- packing
-def packer(params, n_channels: int | None = None) -> Callable[[dict], np.ndarray]:
-    """The standard ``pack`` of a definition with *params*: validated values → rows (C, K),
-    each parameter one column in declared order; colour parameters per channel (a scalar
-    repeated), bools 1.0/0.0, choices their index, an optional None 0.0. *n_channels*: a
-    fixed channel count (None: the colour parameters given per channel say, else 1)."""
-    params = tuple(params)
-
-    def pack(values: dict) -> np.ndarray:
-        C = n_channels
-        if C is None:
-            sizes = [np.size(values[p.name]) for p in params
-                     if p.kind == "colour" and np.ndim(values[p.name]) == 1]
-            C = sizes[0] if sizes else 1
-        rows = np.zeros((C, len(params)))
-        for k, p in enumerate(params):
-            v = values[p.name]
-            if v is None:
-                continue  # "not given": 0.0 (Param.optional)
-            if p.kind == "bool":
-                rows[:, k] = 1.0 if v else 0.0
-            elif p.kind == "choice":
-                rows[:, k] = float(p.choices.index(v))
-            else:
-                rows[:, k] = np.broadcast_to(np.asarray(v, dtype=np.float64), (C,))
-        return rows
-
-    return pack
-
-
+# --------------------------------------------------------------------------- NumPy
 def interpreted_driver(kernel) -> Callable:
     """``driver(wi, wo, P, out) -> n_bad`` as :func:`~brdfkit.models._drivers.loop_driver`
     gives, running the NumPy version of the formula *kernel* (:func:`numpy_version`) over
@@ -416,6 +386,8 @@ class FormulaBRDF(TabulatedSampler, DerivedBRDF):
         return int(fixed)
 
     def _pack(self) -> np.ndarray:
+        if self._definition.pack is None:
+            return super()._pack()  # the packing of every model
         rows = np.ascontiguousarray(np.array(self._definition.pack(self._values),
                                              dtype=np.float64, ndmin=2))
         if rows.shape[0] != (self.n_channels or 1):

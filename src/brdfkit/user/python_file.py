@@ -69,7 +69,6 @@ from brdfkit.user.model import (
     ModelDefinition,
     SamplerFormulas,
     measure_isotropy,
-    packer,
 )
 
 __all__ = ["definition", "definitions"]
@@ -291,18 +290,17 @@ def _definition(shown: str, full: str, module, decl: Declaration, formulas: dict
     if decl.sample is not None:
         sampler = SamplerFormulas(sample=generated.sample, pdf=generated.pdf,
                                   args=_args_builder(label, decl, sampler_names, kinds))
-    pack = packer(decl.params)
     interpreted = not compiled and _interpretable(kernel)
-    _check(label, kernel, sampler, pack, decl, compile=not interpreted)
     target = f"{full}:{decl.name}"
     d = ModelDefinition(
         name=f"{os.path.basename(full)}:{decl.name}", source=full, target=target,
-        params=tuple(decl.params), kernel=kernel, pack=pack, n_channels=None,
+        params=tuple(decl.params), kernel=kernel, pack=None, n_channels=None,
         isotropic=bool(decl.isotropic), reciprocal=decl.reciprocal,
         energy_conserving=decl.energy_conserving, sampler=sampler,
         citation=decl.citation, summary=decl.summary,
         isotropy_reason="declared by the file (define(isotropic=...))",
         interpreted=interpreted)
+    _check(label, d, decl, compile=not interpreted)
     if decl.isotropic is None:  # measured with the definition's own models (interpreted too)
         iso = all(measure_isotropy(FormulaBRDF(d, **values))
                   for values in _parameter_points(decl.params))
@@ -351,10 +349,12 @@ def _interpretable(kernel) -> bool:
     return True
 
 
-def _check(label: str, kernel, sampler, pack, decl: Declaration, *, compile: bool) -> None:
+def _check(label: str, d: ModelDefinition, decl: Declaration, *, compile: bool) -> None:
     """The contract of brdfkit._dual (Dr.Jit's version built: names the function at fault)
-    and a first compilation of each formula (Numba's error, first line); not *compile*:
-    the kernel's NumPy version evaluated once instead (its error, first line)."""
+    and a first compilation of each formula (Numba's error, first line), at the defaults
+    packed as the model packs them; not *compile*: the kernel's NumPy version evaluated
+    once instead (its error, first line)."""
+    kernel, sampler = d.kernel, d.sampler
     if importlib.util.find_spec("drjit") is not None:
         for f in (kernel,) if sampler is None else (kernel, sampler.sample, sampler.pdf):
             try:
@@ -362,7 +362,7 @@ def _check(label: str, kernel, sampler, pack, decl: Declaration, *, compile: boo
             except TypeError as err:
                 raise DataFileError(f"{label}: {err}") from None
     defaults = {p.name: p.validate(p.default, label) for p in decl.params}
-    row = np.ascontiguousarray(pack(defaults)[0])
+    row = np.ascontiguousarray(FormulaBRDF(d, **defaults).packed[0])
     if not compile:
         one, zero = np.ones(1), np.zeros(1)
         try:
