@@ -244,16 +244,18 @@ def read_brdf_file(path) -> BrdfFile:
 
 
 # --------------------------------------------------------------------------- the model
-def _variant(path: str, params: tuple):
-    """The definition for the bools among a model's values (validated as parameters)."""
-    flags = {p.name: Param(p.name, p.default, kind="bool") for p in params if p.kind == "bool"}
+def _variant(f: BrdfFile):
+    """The definition for the bools among a model's values (validated as its parameters),
+    of the content the model was built from: a fit's or an explorer's rebuilds with new
+    values never read the file again."""
+    flags = {p.name: p for p in _declarations(f) if p.kind == "bool"}
     if not flags:
         return None
-    base = os.path.basename(path)
+    base = os.path.basename(f.path)
 
     def variant(values: dict):
-        return definition(path, bools={k: flags[k].validate(v, base) for k, v in values.items()
-                                       if k in flags})
+        return _definition_of(f, {k: flags[k].validate(v, base) for k, v in values.items()
+                                  if k in flags})
 
     return variant
 
@@ -277,7 +279,8 @@ def _declarations(f: BrdfFile) -> tuple:
 
 
 def _layout(f: BrdfFile):
-    """(uniforms with offsets for the given bool values, row width) — floats, then colours."""
+    """(offset of each float and colour parameter in the packed row, the row's width before
+    the channel index): the floats in file order, then the colours, 3 entries each."""
 
     offsets, k = {}, 0
     for p in f.params:
@@ -290,7 +293,7 @@ def _layout(f: BrdfFile):
 
 
 def _packer(f: BrdfFile, name: str, coloured: bool):
-    offsets, width = _layout(f)
+    """The rows of :func:`_layout`, plus the channel index (0 for a grey model)."""
     floats = [p.name for p in f.params if p.kind == "float"]
     colours = [p.name for p in f.params if p.kind == "color"]
 
@@ -308,7 +311,7 @@ def _packer(f: BrdfFile, name: str, coloured: bool):
             return np.array([row + [0.0]], dtype=np.float64)
         return np.array([row + [float(ch)] for ch in range(3)], dtype=np.float64)
 
-    return pack, width
+    return pack
 
 
 _definitions = bounded_cache("brdfkit.user.brdf_file._definitions", maxsize=64)
@@ -327,15 +330,22 @@ def definition(path, *, bools: dict | None = None, compiled: bool = True):
     """
     path = os.path.abspath(os.fspath(path))
     f = read_brdf_file(path)
-    flags = {p.name: bool(p.default) for p in f.params if p.kind == "bool"}
-    unknown = sorted(set(bools or {}) - set(flags))
+    unknown = sorted(set(bools or {}) - {p.name for p in f.params if p.kind == "bool"})
     if unknown:
         raise ParameterError(f"{os.path.basename(path)}: {unknown[0]!r} is not a bool parameter")
-    flags.update({k: bool(v) for k, v in (bools or {}).items()})
-    key = (f.digest, path, tuple(sorted(flags.items())))
+    d = _definition_of(f, bools or {})
+    return d if compiled else replace(d, interpreted=True)
+
+
+def _definition_of(f: BrdfFile, bools: dict):
+    """The definition of the read file *f* with its bools at *bools* (the rest at the
+    file's defaults), translated once per content and bool values."""
+    flags = {p.name: bool(p.default) for p in f.params if p.kind == "bool"}
+    flags.update({k: bool(v) for k, v in bools.items()})
+    key = (f.digest, f.path, tuple(sorted(flags.items())))
     if key not in _definitions:
         _definitions[key] = _build(f, flags)
-    return _definitions[key] if compiled else replace(_definitions[key], interpreted=True)
+    return _definitions[key]
 
 
 def _build(f: BrdfFile, flags: dict):
@@ -358,14 +368,14 @@ def _build(f: BrdfFile, flags: dict):
     else:
         kernel = module.kernel
     coloured = (not tr.grey) or any(p.kind == "color" for p in f.params)
-    pack, _ = _packer(f, base, coloured)
+    pack = _packer(f, base, coloured)
     flag_text = ", ".join(f"{k}={'true' if v else 'false'}" for k, v in flags.items())
     return ModelDefinition(
         name=base, source=f.path, target=f.path, params=_declarations(f), kernel=kernel,
         pack=pack, n_channels=3 if coloured else None, isotropic=tr.isotropic,
         isotropy_reason=tr.isotropy_reason + (f" (with {flag_text})" if flag_text else ""),
         reciprocal=None, energy_conserving=None, sampler=None,
-        variant=_variant(f.path, f.params), citation=f"BRDF Explorer file {base}",
+        variant=_variant(f), citation=f"BRDF Explorer file {base}",
         summary=f"the BRDF of {base} (GLSL translated by brdfkit.glsl, {tr.n_nodes} "
                 "operations; float64)",
         notes=f.notes)
