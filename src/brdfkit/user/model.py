@@ -454,19 +454,16 @@ class FormulaBRDF(TabulatedSampler, DerivedBRDF):
         density(a_, b_, a, p)
         return np.where(b_[:, 2] > 0.0, p, 0.0).reshape(shape)
 
-    def formulas(self) -> Formulas | None:
+    def formulas(self) -> Formulas:
         """The kernel, and the user's sampler and pdf, or else a cosine + GGX proxy sampler
-        fitted to this model's lobe (:func:`brdfkit.user.proxy_sampler.proxy_formulas`;
-        None when it has none): the Mitsuba bridge traces them."""
+        fitted to this model's lobe (:func:`brdfkit.user.proxy_sampler.proxy_formulas`):
+        the Mitsuba bridge traces them."""
         d = self._definition
         if d.sampler is not None:
             return Formulas(eval=d.kernel, sample=d.sampler.sample, pdf=d.sampler.pdf,
                             args=tuple(float(a) for a in d.sampler.args(self.values)))
         from brdfkit.user.proxy_sampler import proxy_formulas
-        proxy = proxy_formulas(self)
-        if proxy is None:
-            return None
-        return Formulas(eval=d.kernel, sample=proxy.sample, pdf=proxy.pdf, args=proxy.args)
+        return proxy_formulas(self)
 
     # ------------------------------------------------------------ rebuild, describe
     def with_params(self, **changes) -> FormulaBRDF:

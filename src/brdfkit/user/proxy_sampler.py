@@ -77,16 +77,15 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from brdfkit._dual import Formulas, cos, formula, maximum, minimum, select, sin, sqrt
 from brdfkit.errors import ParameterError
 from brdfkit.halfangle import trowbridge_reitz_c_from_beta
-from brdfkit.models._base import VECTOR_OPTIONS
-from brdfkit.models._drivers import loop_driver
 from brdfkit.models.microfacet import walter_pdf, walter_sample
 from brdfkit.models.sampling import Strategy
+from brdfkit.user._loops import sampler_loops
+from brdfkit.user.model import SamplerFormulas
 
 __all__ = ["proxy_formulas", "proxy_args", "proxy_sample", "proxy_pdf", "ProxyStrategy",
            "COSINE_WEIGHT", "ALPHA_MIN"]
@@ -164,21 +163,10 @@ def proxy_pdf(ix, iy, iz, ox, oy, oz, alpha, w_c):
 
 
 # --------------------------------------------------------------------------- NumPy access
-@numba.njit(cache=True, **VECTOR_OPTIONS)
-def _sample_rows(wo, u, alpha, w_c, wi):  # pragma: no cover - compiled
-    """proxy_sample over rows: wo (M, 3), u (M, 2) → wi (M, 3)."""
-    for j in range(wo.shape[0]):
-        ox, oy, oz = wo[j, 0], wo[j, 1], wo[j, 2]
-        x, y, z = proxy_sample(ox, oy, oz, u[j, 0], u[j, 1], alpha, w_c)
-        wi[j, 0] = x
-        wi[j, 1] = y
-        wi[j, 2] = z
-
-
-@formula
-def _pdf_kernel(ix, iy, iz, ox, oy, oz, p):
-    """proxy_pdf as a kernel over the packed row (α, w_c): run by the generated pair loop."""
-    return proxy_pdf(ix, iy, iz, ox, oy, oz, p[0], p[1])
+#: The proxy as a sampler of the generated loops that run a user's own sampler
+#: (:func:`brdfkit.user._loops.sampler_loops`); its arguments are a strategy's (α, w_c),
+#: not read from a model's values.
+_PROXY = SamplerFormulas(sample=proxy_sample, pdf=proxy_pdf, args=lambda values: ())
 
 
 def _rows(a: np.ndarray, shape: tuple, k: int) -> np.ndarray:
@@ -214,15 +202,16 @@ class ProxyStrategy(Strategy):
     def sample(self, wo, u):
         shape = np.broadcast_shapes(wo.shape[:-1], u.shape[:-1])
         w, uu = _rows(wo, shape, 3), _rows(u, shape, 2)
-        wi = np.empty_like(w)
-        _sample_rows(w, uu, self.alpha, self.w_c, wi)
+        wi, density = np.empty_like(w), np.empty(w.shape[0])
+        draw, _ = sampler_loops(_PROXY, 2)
+        draw(w, uu, np.array([self.alpha, self.w_c]), wi, density)
         return wi.reshape(shape + (3,))
 
     def pdf(self, wi, wo):
         shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
-        out = np.empty((int(np.prod(shape)), 1))
-        loop_driver(_pdf_kernel, loop="plain")(
-            _rows(wi, shape, 3), _rows(wo, shape, 3), np.array([[self.alpha, self.w_c]]), out)
+        out = np.empty(int(np.prod(shape)))
+        _, density = sampler_loops(_PROXY, 2)
+        density(_rows(wi, shape, 3), _rows(wo, shape, 3), np.array([self.alpha, self.w_c]), out)
         return out.reshape(shape)
 
     def __repr__(self) -> str:
