@@ -32,7 +32,8 @@ import numba
 
 {imports}
 
-# not inlined: the plain loop's Python error model would raise where the pdf divides by 0
+# not inlined: compiled once and called by the plain pair loop (which, as every loop,
+# divides as IEEE does)
 @numba.njit({cache}inline="never", error_model="numpy")
 def pdf_kernel(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
     return _pdf(ix, iy, iz, ox, oy, oz{p_args})
