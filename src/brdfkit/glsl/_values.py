@@ -269,7 +269,7 @@ def select(c: Val, a: Val, b: Val) -> Val:
 
 
 #: functions of one argument that are odd (f(−x) = −f(x)) or even (f(−x) = f(x))
-_ODD = {"neg", "sin", "tan", "asin", "atan", "sign", "cbrt"}
+_ODD = {"sin", "tan", "asin", "atan", "sign"}
 _EVEN = {"absolute", "cos"}
 
 
