@@ -68,8 +68,8 @@ r           0.5      [0, 1]          ``fon``, ``eon``: roughness as the EON pape
                                      names it (0 Lambert, 1 roughest; r > 1 would
                                      make 1 + r s/t negative)
 E_FON       exact    exact|approx    ``eon``: FON's albedo in closed form or the
-                                     paper's quartic in 1 − μ (faster, a ≠ 1 by
-                                     ≤ 1e-3)
+                                     paper's quartic in 1 − μ (faster; for ρ = 1,
+                                     |1 − a| ≤ 5.3e-4 measured)
 ==========  =======  ==============  =============================================
 
 Sampling: cosine (cos θ_i/π, the weight is π f). EON's paper also gives a
@@ -292,11 +292,13 @@ class OrenNayar(_CosineSampled, BRDF):
     form    full     full/qualitative  which of the paper's two forms
     ======  =======  ================  ============================================
 
-    Reciprocal (both forms: symmetric in α, β and cos Δφ). Not energy-conserving:
-    masking and shadowing lose energy that the qualitative form does not return
-    (its white furnace a < 1 at every angle for σ > 0, measured in the tests), and
-    the full form's L_r² adds back only part of it. Both diverge as both directions
-    approach the horizon (tan β), with a finite albedo. Sampled by the cosine.
+    Reciprocal (both forms: symmetric in α, β and cos Δφ). Not energy-conserving,
+    either way (white ρ = 1, measured in the tests): the qualitative form loses up to
+    44 % at normal incidence (1 − a(0°) = 1 − A: 0.22 at σ = 0.5, 0.44 at σ = π/2) but
+    for small σ its B sin α tan β term returns more than 1 at grazing (a(89°) = 1.012
+    at σ = 0.25); the full form's L_r² adds more (a(89°) = 1.043 at σ = 0.25). Both
+    diverge as both directions approach the horizon (tan β), with a finite albedo.
+    Sampled by the cosine.
     """
 
     name = "oren-nayar"
@@ -390,8 +392,8 @@ def eon(ix, iy, iz, ox, oy, oz, p, exact):
     a = 1.0 / (1.0 + C1_FON * r)
     e_avg = a * (1.0 + C2_FON * r)
     rho_ms = rho * rho * e_avg / (1.0 - rho * (1.0 - e_avg))
-    # clamp at 0: the quartic exceeds c₁ by up to 3.2e-4 within ~3° of the horizon (E > 1),
-    # where f_ms would turn negative (the authors' listing floors 1 − E at 1e-7 likewise)
+    # clamp at 0: the quartic exceeds c₁ by up to 4.6e-4 beyond θ = 89.92° (E > 1), where
+    # f_ms would turn negative (the authors' listing floors 1 − E at 1e-7 likewise)
     di = maximum(C1_FON - gi, 0.0)
     do = maximum(C1_FON - go, 0.0)
     f_ms = rho_ms * INV_PI * a * r * di * do / (C1_FON - C2_FON)
@@ -472,7 +474,7 @@ class EON(_CosineSampled, BRDF):
     r      0.5      [0, 1]        roughness; 0 is Lambert
     E_FON  exact    exact/approx  FON's albedo in f_ms: the closed form (a = 1 for
                                   ρ = 1 to the engine's accuracy) or the paper's
-                                  quartic (cheaper; a = 1 to ~1e-3)
+                                  quartic (cheaper; |1 − a| ≤ 5.3e-4)
     =====  =======  ============  ===============================================
 
     Reciprocal. Energy-preserving: for ρ = 1 the albedo is 1 at every angle with
