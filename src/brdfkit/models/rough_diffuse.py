@@ -450,13 +450,13 @@ class FON(_CosineSampled, BRDF):
     citation = "Portsmouth, Kutz, Hill 2025 (EON) §3, Listing 1 (after Fujii's improved Oren-Nayar)"
     reciprocal = True
     kernel = _fon
-    _formula = _fon
     examples = (
         {},
         {"r": 1.0, "rho": [0.2, 0.5, 1.0]},
     )
 
     def _validate(self):
+        self._formula = _fon  # per instance: a dispatcher class attribute would bind as a method
         self._driver = loop_driver(_fon, loop="vector")
 
 
