@@ -77,7 +77,7 @@ from brdfkit.models.rough_diffuse import (
     C1_FON,
     C2_FON,
     FON_PARAMS,
-    _CosineSampled,
+    _RoughDiffuse,
     fon,
     g_approx,
     g_exact,
@@ -268,7 +268,7 @@ class EONStrategy(Strategy):
 
 
 @register
-class EON(StrategySampled, _CosineSampled, BRDF):
+class EON(StrategySampled, _RoughDiffuse, BRDF):
     """EON (Portsmouth, Kutz, Hill 2025): FON plus its energy compensation.
 
     f = f_FON + (ρ_ms/π)(1 − E_FON(μ_i))(1 − E_FON(μ_o))/(1 − Ē_FON),

@@ -254,9 +254,10 @@ def cosine_pdf(ix, iy, iz, ox, oy, oz):
     return select(oz > 0.0, maximum(iz, 0.0) * INV_PI, 0.0)
 
 
-class _CosineSampled:
-    """Cosine sampling (``BRDF.sample``/``pdf``, exact for the diffuse lobe's cosine) and
-    the formulas of this instance's kernel (``_formula``) for the Mitsuba bridge."""
+class _RoughDiffuse:
+    """What the rough diffuse models share: one diffuse lobe, the N·V = N·L kink circle,
+    cosine sampling (``BRDF.sample``/``pdf``; the weight is π f) and the formulas of this
+    instance's kernel (``_formula``, set by ``_validate``) for the Mitsuba bridge."""
 
     has_sampler = True
 
@@ -275,7 +276,7 @@ class _CosineSampled:
 
 
 @register
-class OrenNayar(_CosineSampled, BRDF):
+class OrenNayar(_RoughDiffuse, BRDF):
     """Oren & Nayar (1994): Lambertian V-cavities with Gaussian slope angles, std σ.
 
     ``form="full"``: the functional approximation with C₁, C₂, C₃ and the
@@ -372,7 +373,7 @@ def _fon(ix, iy, iz, ox, oy, oz, p):
 
 
 @register
-class FON(_CosineSampled, BRDF):
+class FON(_RoughDiffuse, BRDF):
     """Fujii's improved Oren–Nayar (FON), as the EON paper writes it (§3).
 
     f = ρ/π · A (1 + r s/t), s = ω_i·ω_o − μ_iμ_o, t = max(μ_i, μ_o) for s > 0 else 1,
