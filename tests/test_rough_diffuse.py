@@ -17,7 +17,10 @@ References, each independent of the module's dot-product kernels:
 - the authors' published GLSL (repository ``portsmouth/OpenPBR-viewer``, file
   ``glsl/pathtracing/diffuse_brdf.glsl``, ``f_EON``, ``E_FON_approx``): values it gives,
   run once in real GLSL (Mesa llvmpipe, float32) outside this repository and recorded
-  below (``PUBLISHED``); its code is not in this repository.
+  below (``PUBLISHED``), and its sampler ``sample_EON``/``pdf_EON`` likewise
+  (``PUBLISHED_SAMPLER``); its code is not in this repository;
+- a product Gauss–Legendre rule split at the kinks (second method beside the albedo
+  engine) where a finding rests on one number (Oren–Nayar's albedo above 1 at grazing).
 """
 
 from __future__ import annotations
