@@ -65,7 +65,7 @@ def test_microfacet_split_is_the_definition():
     ref = rho * fresnel_conductor(cos_d, eta, k) * split.white.eval(wi, wo)[:, None]
     np.testing.assert_allclose(m.eval(wi, wo), ref, rtol=1e-12, atol=1e-300)
     for c in range(3):
-        ref_avg = quad(lambda mu: 2 * mu * fresnel_conductor(mu, eta[c], k[c]), 0, 1,
+        ref_avg = quad(lambda mu, c=c: 2 * mu * fresnel_conductor(mu, eta[c], k[c]), 0, 1,
                        epsabs=1e-15)[0]
         assert split.f_avg[c] == pytest.approx(rho[c] * ref_avg, abs=1e-12)
         assert split.f0[c] == pytest.approx(rho[c] * fresnel_conductor(1.0, eta[c], k[c]))
