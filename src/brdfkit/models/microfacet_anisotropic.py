@@ -58,7 +58,7 @@ from brdfkit.errors import ParameterError
 from brdfkit.fresnel import _fresnel_conductor
 from brdfkit.models._base import BRDF, VECTOR_OPTIONS, Lobe, Param
 from brdfkit.models._drivers import loop_driver
-from brdfkit.models._params import ETA, packed_indices
+from brdfkit.models._params import ETA, eta_fresnel_split, packed_indices
 from brdfkit.models._registry import register
 from brdfkit.models.anisotropic_distributions import (
     anisotropic_distribution,
@@ -248,6 +248,11 @@ class MicrofacetAnisotropic(StrategySampled, BRDF):
     def lobes(self):
         # the narrower axis sets the resolution; a half-vector lobe (D of h)
         return [Lobe("half", float(min(self._values["alpha_x"], self._values["alpha_y"])))]
+
+    def fresnel_split(self):
+        """F = ρ_s · F_conductor(η, κ) (1 without η); white: η not given, κ = 0, ρ_s = 1 (as
+        :meth:`~brdfkit.models.microfacet.Microfacet.fresnel_split`)."""
+        return eta_fresnel_split(self, k="k", scale="rho_s")
 
     def _strategy(self, wo):
         v = self._values
