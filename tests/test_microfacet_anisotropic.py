@@ -54,7 +54,7 @@ def pairs(rng, n, spread=0.3):
     return wi, wo
 
 
-# --------------------------------------------------------------------------- the second implementation
+# ------------------------------------------------------------------ the second implementation
 def fresnel_conductor(c, eta, k):
     """Unpolarised reflectance of a complex index η + iκ at cos θ = c (Fresnel's amplitudes)."""
     n = np.asarray(eta, dtype=complex) + 1j * np.asarray(k, dtype=float)
@@ -112,7 +112,7 @@ def test_against_the_angles_form(dist, ax, ay):
                                rtol=1e-9, atol=1e-14 * want.max())
 
 
-# --------------------------------------------------------------------------- = microfacet at α_x = α_y
+# ------------------------------------------------------------------ = microfacet at α_x = α_y
 @pytest.mark.parametrize("dist", ["ggx", "beckmann"])
 @pytest.mark.parametrize("alpha", [1e-3, 0.1, 0.5, 2.0])
 def test_isotropic_case_is_microfacet(dist, alpha):
@@ -164,7 +164,8 @@ def _gauss_legendre(n):
 
 
 def brute_albedo(m, theta, phi, n=1200):
-    """∫ f cos θ_o dω_o by a product Gauss–Legendre rule in (cos θ_o, φ_o), no lobe frame (1200²: converged to 3e-8 here, against 2400²)."""
+    """∫ f cos θ_o dω_o by a product Gauss–Legendre rule in (cos θ_o, φ_o), no lobe frame
+    (1200²: converged to 3e-8 here, against 2400²)."""
     x, w = _gauss_legendre(n)
     mu, ph = 0.5 * (x + 1.0), math.pi * (x + 1.0)
     M, P = np.meshgrid(mu, ph, indexing="ij")
