@@ -248,8 +248,8 @@ class AshikhminShirley(StrategySampled, BRDF):
     Energy: the paper claims conservation (albedo ≤ 1 for R_s, R_d ≤ 1: the specular
     lobe normalised by max(μ_i, μ_o), the diffuse term scaled by 1 − R_s); measured with
     the albedo engine in ``tests/test_ashikhmin_shirley.py``: max 0.9960 (R_s = 1,
-    n_u = n_v = 1000, θ_i = 0), 31/32 + the Schlick tail at R_s = 0. Sampled by the paper's half-vector sampler (§3)
-    mixed with the cosine for the diffuse term.
+    n_u = n_v = 1000, θ_i = 0), 31/32 + the Schlick tail at R_s = 0. Sampled by the
+    paper's half-vector sampler (§3) mixed with the cosine for the diffuse term.
     """
 
     name = "ashikhmin-shirley"
