@@ -3,8 +3,8 @@
 References, each independent of the model's code:
 
 - a second implementation written here in *angles* from the equations (Walter 2007
-  eq. 20; D of Heitz 2014 eqs. 84-85 as tan²θ_h (cos²φ_h/α_x² + sin²φ_h/α_y²); Smith Λ of
-  the projected roughness α(φ) = √(cos²φ α_x² + sin²φ α_y²), Heitz eq. 86, with Walter's
+  eq. 20; D of Heitz 2014 §5.3 as tan²θ_h (cos²φ_h/α_x² + sin²φ_h/α_y²); Smith Λ of
+  the projected roughness α(φ) = √(cos²φ α_x² + sin²φ α_y²), Heitz §5.3, with Walter's
   eqs. 27 (erf form) and 34; the exact conductor Fresnel from complex amplitudes);
 - the registered isotropic ``microfacet`` at α_x = α_y (equal to rounding: values,
   samples, pdf, albedo);
@@ -219,7 +219,7 @@ def test_distribution_objects():
     w = sph(np.arccos(rng.uniform(0.05, 1.0, 2000)), rng.uniform(0, 2 * math.pi, 2000))
     for kind in ("ggx", "beckmann"):
         dist = anisotropic_distribution(kind, 0.2, 0.7)
-        # Λ of the projected roughness (Heitz eq. 86) against the test's own Λ: the G₁ of
+        # Λ of the projected roughness (Heitz §5.3) against the test's own Λ: the G₁ of
         # walter_angles at normal ω_o is 1/(1 + Λ(ω_i)) times D/(4 cos θ_i) … use G₁ directly
         t, p = np.arccos(w[:, 2]), np.arctan2(w[:, 1], w[:, 0])
         alpha = np.sqrt(np.cos(p) ** 2 * 0.04 + np.sin(p) ** 2 * 0.49)

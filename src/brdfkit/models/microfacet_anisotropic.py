@@ -5,7 +5,7 @@ The anisotropic Walter et al. (2007) microfacet model
 Walter's eq. (20) with the anisotropic GGX or Beckmann distribution of
 :mod:`brdfkit.models.anisotropic_distributions` (α_x along brdfkit's tangent X = +x,
 α_y along the bitangent Y = +y) and the Smith G₁ of the projected roughness
-α(ω) = √(cos²φ α_x² + sin²φ α_y²) (Heitz 2014 eq. 86): the model of Mitsuba 3's
+α(ω) = √(cos²φ α_x² + sin²φ α_y²) (Heitz 2014 §5.3): the model of Mitsuba 3's
 ``roughconductor`` with ``alpha_u``/``alpha_v`` and of pbrt-v4's ``conductor`` with
 ``uroughness``/``vroughness``. At α_x = α_y it is :class:`~brdfkit.models.microfacet.Microfacet`
 to rounding.
@@ -43,7 +43,8 @@ References
 ----------
 - [Walter2007] eq. (20) (BRDF), (25)-(28) Beckmann, (33)-(35) GGX.
 - [Heitz2014] E. Heitz, *Understanding the Masking-Shadowing Function in
-  Microfacet-Based BRDFs*, JCGT 3(2), 2014, eqs. (84)-(86), §5.3.
+  Microfacet-Based BRDFs*, JCGT 3(2), 2014, §5.3 (anisotropic distributions by stretching; equation
+  numbers not cited: the paper is not on this machine).
 """
 
 from __future__ import annotations
@@ -220,7 +221,7 @@ class MicrofacetAnisotropic(StrategySampled, BRDF):
     summary = "anisotropic Walter 2007 microfacet BRDF (Beckmann/GGX with alpha_x, alpha_y)"
     params = PARAMS
     citation = ("Walter et al. 2007 eq. (20) with (25)-(27)/(33)-(34) made anisotropic; "
-                "Heitz 2014 eqs. (84)-(86)")
+                "Heitz 2014 §5.3")
     reciprocal = True
     isotropic = False
     has_sampler = True

@@ -315,7 +315,7 @@ def d_ggx_of_h(hz2: float, hxy2: float, inv_a2: float, alpha: float) -> float:
 def d_ggx_of_u(u: float, a2: float) -> float:
     """GGX D = 1/(π a2 u²) from u = h_z² + |h_xy|²/α² (isotropic, a2 = α²) or
     h_z² + (h_x/α_x)² + (h_y/α_y)² (anisotropic, a2 = α_x α_y): Walter eq. (33) and its
-    anisotropic form (Heitz 2014 eq. 85) multiplied out."""
+    anisotropic form (Heitz 2014 §5.3) multiplied out."""
     return 1.0 / (PI * a2 * (u * u))
 
 
