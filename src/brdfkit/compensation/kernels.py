@@ -11,13 +11,17 @@ module cached on disk) and memoised per (base kernel, offset).
 Packed row of one channel (``p``): the base's K parameters, then the channel's
 constant at ``p[K]`` (Kulla–Conty: F_ms/(π(1 − E_avg)); Turquin: F₀), then the
 :class:`~brdfkit.tables.Lookup` of Ẽ at ``p[K + 1:]`` (padded to the longest
-channel's).
+channel's). The lookup is an upper bound of min(E, 1) within its margin; the kernels
+clamp what they read at 1 (:func:`_e`), so 1 − Ẽ ≥ 0 and the compensated albedo
+1 + E − Ẽ never exceeds 1 by the table's error (``docs/compensation.md``).
 
 - :func:`kulla_conty_kernel` — f_base + c (1 − Ẽ(μ_i))(1 − Ẽ(μ_o));
 - :func:`turquin_kernel` — f_base (1 + F₀ (1 − Ẽ(μ_i))/Ẽ(μ_i)).
 """
 
 from __future__ import annotations
+
+import numba
 
 from brdfkit.models._drivers import composed
 from brdfkit.tables import _lookup
@@ -30,12 +34,18 @@ base_kernel = None  # a kernel (ix, iy, iz, ox, oy, oz, p) -> float
 k = 0
 
 
+@numba.njit(cache=True, inline="always")
+def _e(p, off, mu):  # pragma: no cover - compiled (inlined into the templates)
+    e = _lookup(p, off, mu)
+    return e if e < 1.0 else 1.0  # clamp: the lookup's margin may exceed min(E, 1) = 1
+
+
 def _kulla_conty(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
     f = base_kernel(ix, iy, iz, ox, oy, oz, p)  # 0 below the horizon
     if not (iz > 0.0 and oz > 0.0):
         return f
-    e_i = _lookup(p, k + 1, iz)
-    e_o = _lookup(p, k + 1, oz)
+    e_i = _e(p, k + 1, iz)
+    e_o = _e(p, k + 1, oz)
     return f + p[k] * (1.0 - e_i) * (1.0 - e_o)
 
 
@@ -43,7 +53,7 @@ def _turquin(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
     f = base_kernel(ix, iy, iz, ox, oy, oz, p)  # 0 below the horizon
     if f == 0.0:
         return 0.0
-    e_i = _lookup(p, k + 1, iz)  # >= E_FLOOR > 0 (brdfkit.compensation.table)
+    e_i = _e(p, k + 1, iz)  # >= E_FLOOR > 0 (brdfkit.compensation.table)
     return f * (1.0 + p[k] * (1.0 - e_i) / e_i)
 
 

@@ -187,7 +187,7 @@ class CompensatedBRDF(DerivedBRDF):
     # -------------------------------------------------------------- evaluation
     def _e(self, mu) -> np.ndarray:
         """Ẽ(μ) per row of ``packed``: shape ``mu.shape + (C,)``."""
-        e = self.table(mu)
+        e = self.table(mu)  # clamped at 1, as the kernels read it
         return np.broadcast_to(e, (*e.shape[:-1], self.packed.shape[0]))
 
     def eval(self, wi, wo) -> np.ndarray:
