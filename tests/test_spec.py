@@ -315,6 +315,9 @@ def test_batch_jobs_and_explorer_entries_are_specs():
     assert entry_spec(entry) == want
     assert entry_spec({"spec": "modified-phong", "params": {"beta": 30}, "pump": None,
                        "times": 1}) == ModelSpec.parse("modified-phong", ["beta=30"])
+    assert entry_spec({"spec": "modified-phong", "params": {"n": 20}, "compensate": "turquin",
+                       "pump": None}) == ModelSpec.parse("modified-phong", ["n=20"],
+                                                         compensate="turquin")
 
 
 def test_mitsuba_plugin_properties_are_the_spec_vocabulary():

@@ -155,7 +155,12 @@ class CompensatedBRDF(DerivedBRDF):
         self.constant = spec.constant(self)
         kernel = driver = None
         if base.kernel is not None:
-            kernel, driver = spec.kernel(base.kernel, base.packed.shape[1])
+            # a base whose eval is a formula (branch-free and total: the _dual contract)
+            # composes into the vectorising loop, like its own eval (microfacet's)
+            formulas = base.formulas()
+            vector = formulas is not None and formulas.eval is not None
+            kernel, driver = spec.kernel(formulas.eval if vector else base.kernel,
+                                         base.packed.shape[1], vector=vector)
         own = ("its own white form: all energy missing from its albedo (absorption "
                "included) is treated as lost to unmodelled multiple scattering, so its "
                "white furnace goes to 1 in every channel" if split is None else
