@@ -333,7 +333,10 @@ def test_measured_material_means_its_furnace_goes_to_one():
     m = compensate(mat)
     assert "lost to unmodelled multiple scattering" in m.summary
     a = np.asarray(albedo(m, np.radians([0.0, 60.0]), tol=1e-7).albedo)
+    assert a.shape == (2, 3) and m.n_channels == mat.n_channels == 3
     np.testing.assert_allclose(a, 1.0, atol=1e-5)
+    wi, wo = _random_pairs(200, 9)
+    assert m.eval(wi, wo).shape == (200, 3)
 
 
 def test_energy_gaining_base_is_clamped_with_a_warning():

@@ -41,6 +41,11 @@ _THETA_FORMS = ("--theta must be START:STOP:COUNT (COUNT angles, inclusive, like
                 "0,30,60)")
 
 
+def _compensated(d: dict) -> str:
+    """The text outputs' note of a compensation (none when the model has none)."""
+    return f"  compensated ({d['compensate']['method']})" if "compensate" in d else ""
+
+
 def parse_theta(text: str) -> np.ndarray:
     """``START:STOP:COUNT`` (inclusive, like numpy.linspace) or ``a,b,c`` in degrees → degrees.
 
@@ -175,7 +180,7 @@ def albedo_cmd(model, param, compensate, pump, times, theta, phi, tol, as_json, 
             click.echo(",".join([f"{th[k]:.10g}", *([f"{phi_deg:.10g}"] if with_phi else [])]
                                 + [f"{v:.12g}" for v in vals]))
         return
-    click.echo(f"# {d['model']} {d['params']}")
+    click.echo(f"# {d['model']} {d['params']}{_compensated(d)}")
     note = _phi_note(m, phi_deg)
     if note:
         click.echo(f"# note: {note}")
@@ -241,7 +246,7 @@ def check_cmd(model, param, compensate, pump, times, phi, as_json):
     if as_json:
         emit_json(d)
         return
-    click.echo(f"model:        {d['model']}  {d['params']}")
+    click.echo(f"model:        {d['model']}  {d['params']}{_compensated(d)}")
     if not m.isotropic:
         click.echo(f"azimuth:      phi = {phi_deg:g} deg (anisotropic: the energy verdict is "
                    "at this incidence azimuth)")

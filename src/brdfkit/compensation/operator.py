@@ -174,6 +174,9 @@ class CompensatedBRDF(DerivedBRDF):
             has_sampler=base.has_sampler, isotropic=True, has_delta=base.has_delta,
             width_param=base.width_param, kernel=kernel)
         self._driver = driver
+        # the base's channels (a material declares them by its packed rows, not by colour
+        # parameters, which the shared set-up counts)
+        self.n_channels = base.n_channels
         self.albedo_kinks = base.albedo_kinks
         self.albedo_kink_mus = base.albedo_kink_mus
 
