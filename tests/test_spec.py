@@ -264,7 +264,7 @@ def test_dict_errors_name_the_key():
     with pytest.raises(ParameterError, match="expected a dict with a 'model' key"):
         ModelSpec.from_dict({"params": {}})
     with pytest.raises(ParameterError, match="unknown key 'pumped'; valid keys: model, params, "
-                                             "pump, times"):
+                                             "pump, compensate, times"):
         ModelSpec.from_dict({"model": "lambert", "pumped": "max"})
     with pytest.raises(ParameterError, match="lambert: params must be an object NAME: VALUE"):
         ModelSpec.from_dict({"model": "lambert", "params": [1, 2]})
@@ -276,8 +276,10 @@ def test_dict_errors_name_the_key():
         ModelSpec.from_dict({"model": "lambert", "pump": {"g": "max", "k": 2}})
     with pytest.raises(ParameterError, match="a custom g cannot be rebuilt"):
         ModelSpec.from_dict({"model": "lambert", "pump": {"g": "custom", "times": 1}})
-    with pytest.raises(ParameterError, match="unknown operator 'compensate'; valid: pump"):
-        Operator("compensate")
+    with pytest.raises(ParameterError, match="unknown operator 'smooth'; valid: pump, "
+                                             "compensate"):
+        Operator("smooth")
+    assert Operator("compensate").arguments == {"method": "kulla-conty"}  # the default
     with pytest.raises(ParameterError, match="expected a brdfkit model"):
         ModelSpec.of({"model": "lambert"})
     with pytest.raises(ParameterError, match="model must be a model name"):
