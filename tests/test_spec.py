@@ -164,6 +164,35 @@ def test_stages_with_different_g_round_trip():
     np.testing.assert_array_equal(spec.build().eval(wi, wo), m.eval(wi, wo))
 
 
+def test_compensated_model_round_trip():
+    """compensate (issue 22): the dict form, the flat form, of(m).build(), and the order of
+    operators kept (compensate, then pump: the dict's keys in the order applied)."""
+    spec = ModelSpec.parse("microfacet", ["distribution=ggx", "alpha=0.5"],
+                           compensate="kulla-conty", pump="max")
+    assert spec.operators == (Operator("compensate", (("method", "kulla-conty"),)),
+                              Operator("pump", (("g", "max"), ("times", 1))))
+    m = spec.build()
+    d = m.to_dict()
+    assert list(d) == ["model", "params", "compensate", "pump"]
+    assert d["compensate"] == {"method": "kulla-conty"}
+    by_hand = pump(brdfkit.compensate(brdfkit.model("microfacet", distribution="ggx",
+                                                    alpha=0.5)), "max")
+    wi, wo = _pairs(30)
+    want = by_hand.eval(wi, wo)
+    np.testing.assert_array_equal(m.eval(wi, wo), want)
+    np.testing.assert_array_equal(ModelSpec.of(m).build().eval(wi, wo), want)
+    t = brdfkit.compensate(brdfkit.model("modified-phong", n=20), "turquin")
+    flat = ModelSpec.from_dict({"model": "modified-phong", "params": t.to_dict()["params"],
+                                "compensate": "turquin"})
+    assert flat == ModelSpec.of(t)
+    np.testing.assert_array_equal(flat.build().eval(wi, wo), t.eval(wi, wo))
+    assert ModelSpec.from_dict({"model": "lambert", "compensate": None}).operators == ()
+    with pytest.raises(BrdfkitError, match="--compensate must be one of kulla-conty, turquin"):
+        ModelSpec.parse("lambert", compensate="kc2")
+    with pytest.raises(ParameterError, match="compensate: unknown argument 'g'; valid: method"):
+        ModelSpec.from_dict({"model": "lambert", "compensate": {"g": "max"}})
+
+
 def test_pumped_material_rebuilds_from_its_dict():
     """The bug of issue 18: pumping.from_dict resolved names in the model registry only, so
     a pumped material (whose to_dict names merl:…) could not be rebuilt."""
@@ -207,7 +236,7 @@ def test_merl_file_spec(tmp_path):
 
 def test_tables_name_every_kind_and_operator():
     assert [k.name for k in KINDS] == ["python-file", "brdf-file", "material", "merl-file", "model"]
-    assert list(OPERATORS) == ["pump"]
+    assert list(OPERATORS) == ["pump", "compensate"]
     assert ModelSpec("nickel").kind == "model"  # the fallback claims the rest (then fails)
 
 
@@ -235,7 +264,7 @@ def test_dict_errors_name_the_key():
     with pytest.raises(ParameterError, match="expected a dict with a 'model' key"):
         ModelSpec.from_dict({"params": {}})
     with pytest.raises(ParameterError, match="unknown key 'pumped'; valid keys: model, params, "
-                                             "pump, times"):
+                                             "pump, compensate, times"):
         ModelSpec.from_dict({"model": "lambert", "pumped": "max"})
     with pytest.raises(ParameterError, match="lambert: params must be an object NAME: VALUE"):
         ModelSpec.from_dict({"model": "lambert", "params": [1, 2]})
@@ -247,8 +276,10 @@ def test_dict_errors_name_the_key():
         ModelSpec.from_dict({"model": "lambert", "pump": {"g": "max", "k": 2}})
     with pytest.raises(ParameterError, match="a custom g cannot be rebuilt"):
         ModelSpec.from_dict({"model": "lambert", "pump": {"g": "custom", "times": 1}})
-    with pytest.raises(ParameterError, match="unknown operator 'compensate'; valid: pump"):
-        Operator("compensate")
+    with pytest.raises(ParameterError, match="unknown operator 'smooth'; valid: pump, "
+                                             "compensate"):
+        Operator("smooth")
+    assert Operator("compensate").arguments == {"method": "kulla-conty"}  # the default
     with pytest.raises(ParameterError, match="expected a brdfkit model"):
         ModelSpec.of({"model": "lambert"})
     with pytest.raises(ParameterError, match="model must be a model name"):
@@ -286,6 +317,9 @@ def test_batch_jobs_and_explorer_entries_are_specs():
     assert entry_spec(entry) == want
     assert entry_spec({"spec": "modified-phong", "params": {"beta": 30}, "pump": None,
                        "times": 1}) == ModelSpec.parse("modified-phong", ["beta=30"])
+    assert entry_spec({"spec": "modified-phong", "params": {"n": 20}, "compensate": "turquin",
+                       "pump": None}) == ModelSpec.parse("modified-phong", ["n=20"],
+                                                         compensate="turquin")
 
 
 def test_mitsuba_plugin_properties_are_the_spec_vocabulary():
