@@ -153,13 +153,17 @@ def test_kulla_conty_white_furnace_beckmann_and_phong(model):
 
 def test_compensated_albedo_never_exceeds_one_by_the_tables():
     """E is read as an upper bound (clamped at 1), so a = 1 + E − Ẽ ≤ 1 up to the engine's
-    error; and the table beyond the engine's 89.9° (extended, then held from 89.99°)
-    keeps the excess within 1e-4 at the horizon."""
+    error, also beyond the table's 89.9° (the grazing piece, engine values to 89.999°);
+    and brdfkit's check, which looks up to 89.999°, finds the compensated model
+    conserving energy."""
+    from brdfkit.analysis import check
+
     m = compensate(brdfkit.model("microfacet", distribution="ggx", alpha=0.5))
-    r = albedo(m, np.radians([0.0, 45.0, 80.0, 89.0, 89.9, 89.99, 89.999]), tol=1e-9)
+    r = albedo(m, np.radians([0.0, 45.0, 80.0, 89.0, 89.9, 89.95, 89.99, 89.999]), tol=1e-9)
     a = np.asarray(r.albedo)
-    assert np.all(a[:5] <= 1.0 + 1e-8), a
-    assert np.all(np.abs(1.0 - a) < 1e-4), a
+    assert np.all(a <= 1.0 + 1e-8), a
+    assert np.all(np.abs(1.0 - a) < 2e-6), a
+    assert check(compensate(brdfkit.model("modified-phong"))).energy == "conserves"
 
 
 # ================================================================== Turquin

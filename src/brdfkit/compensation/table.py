@@ -40,8 +40,14 @@ import numpy as np
 
 from brdfkit.errors import ParameterError
 from brdfkit.models._base import BRDF
-from brdfkit.pumping.table import THETA_TOP, AlbedoTable, _crossings, build_albedo_table
-from brdfkit.tables import LUT_TOL, Lookup, _as_2d, build_lookup, mu_of_w, w_of_mu
+from brdfkit.pumping.table import (
+    THETA_TOP,
+    AlbedoTable,
+    _crossings,
+    _engine,
+    build_albedo_table,
+)
+from brdfkit.tables import LUT_TOL, Lookup, _as_2d, build_lookup, mu_of_w, theta_of_w, w_of_mu
 
 __all__ = ["E_FLOOR", "ENGINE_TOL", "TABLE_TOL", "CompensationTable", "compensation_table"]
 
@@ -57,11 +63,11 @@ ENGINE_TOL = 1e-7
 #: Smallest stored E: the lookup needs a positive function, and Turquin divides by E. An
 #: albedo this small comes only from rounding at the horizon of a sharp lobe.
 E_FLOOR = 1e-12
-#: Where the spline's extension below THETA_TOP ends (the value is held from there to the
+#: Where the grazing piece below THETA_TOP ends (the value is held from there to the
 #: horizon): E is smooth in w but behaves like √μ at the horizon, which the kernel's lookup
-#: (cells uniform in μ) would need thousands of intervals for; held below 89.99°, a kink
+#: (cells uniform in μ) would need thousands of intervals for; held below 89.999°, a kink
 #: the lookup makes a node (docs/compensation.md, "Tables and their accuracy").
-THETA_HOLD = math.radians(89.99)
+THETA_HOLD = math.radians(89.999)
 #: Gauss–Legendre nodes on [0, 1] exact for a quartic (E·μ on one cubic piece of the lookup).
 _GL_X, _GL_W2 = np.polynomial.legendre.leggauss(3)
 _GL_T, _GL_W = 0.5 * (_GL_X + 1.0), 0.5 * _GL_W2  # mapped from [−1, 1] to [0, 1]
@@ -157,25 +163,43 @@ class CompensationTable:
                 "message": self.message}
 
 
-def _spline_e(spline: AlbedoTable, mu) -> np.ndarray:
-    """The spline's E at μ (T,) → (T, C), its first cubic extended below THETA_TOP.
+def _grazing_piece(model: BRDF, spline: AlbedoTable):
+    """E on [w(THETA_HOLD), w(THETA_TOP)]: the engine's values, a cubic spline in w.
 
-    Pumping's table holds E(THETA_TOP) from there to the horizon; the compensations
-    should not: Kulla–Conty's albedo is 1 + E − Ẽ, so a value held from 89.9° costs
-    E(θ) − E(89.9°) beyond (8e-4 at 89.999° for GGX α = 0.5). E is smooth in w
-    (μ = 2w² − w⁴ is a polynomial of w), so the first interval's cubic is extended down
-    to THETA_HOLD and held below (measured in tests/test_compensation.py).
+    Pumping's table holds E(THETA_TOP) from 89.9° to the horizon; the compensations
+    should not: Kulla–Conty's albedo is 1 + E − Ẽ, so a held value costs E(θ) − E(89.9°)
+    beyond (8e-4 at 89.999° for GGX α = 0.5), and extending the table's first cubic cost
+    1e-5 at 89.99°. The engine integrates there too (its accuracy stays *engine_tol*):
+    8 intervals uniform in w, doubled until the midpoints meet :data:`TABLE_TOL` (at most
+    64). Returns (CubicSpline, max midpoint error (C,), engine angles).
     """
+    from scipy.interpolate import CubicSpline
+
+    run = _engine(model, ENGINE_TOL)
+    w0, w1 = float(w_of_mu(math.cos(THETA_HOLD))), spline.s_top
+    nn, n_eval = 8, 0
+    while True:
+        nodes = np.linspace(w0, w1, nn + 1)
+        mids = 0.5 * (nodes[:-1] + nodes[1:])
+        vals = _as_2d(run(theta_of_w(nodes)))
+        ref = _as_2d(run(theta_of_w(mids)))
+        n_eval += 2 * nn + 1
+        cs = CubicSpline(nodes, vals, axis=0)
+        err = np.max(np.abs(cs(mids) - ref), axis=0)
+        if np.all(err <= TABLE_TOL) or nn >= 64:
+            return cs, err, n_eval
+        nn *= 2
+
+
+def _spline_e(spline: AlbedoTable, grazing, mu) -> np.ndarray:
+    """E at μ (T,) → (T, C): the table, the grazing piece (:func:`_grazing_piece`) below
+    THETA_TOP, held from THETA_HOLD to the horizon."""
     mu = np.asarray(mu, dtype=np.float64)
     out = _as_2d(spline.at_cos(mu)).copy()
     below = mu < math.cos(THETA_TOP)
     if np.any(below):
-        h = (spline.breaks[1] - spline.breaks[0]) / spline.piece_nn[0]
         w = w_of_mu(np.maximum(mu[below], math.cos(THETA_HOLD)))  # held below THETA_HOLD
-        t = (w - spline.s_top) / h  # in [(w(THETA_HOLD) − w_top)/h, 0)
-        c = spline.coeffs[:, 0, :]  # (C, 4), highest power first
-        out[below] = (((c[:, 0] * t[:, None] + c[:, 1]) * t[:, None] + c[:, 2]) * t[:, None]
-                      + c[:, 3])
+        out[below] = _as_2d(grazing(w))
     return out
 
 
@@ -200,16 +224,16 @@ def _lookup_average(lk: Lookup) -> float:
     return float(np.sum(2.0 * mu * e * _GL_W[None, :] * width[:, None]))
 
 
-def _spline_average(spline: AlbedoTable) -> np.ndarray:
-    """2∫₀¹ min(E, 1) μ dμ of the (extended) spline: 64 Gauss–Legendre nodes on [0, w_top]
-    and on each grid piece in w (dμ = 4w(1 − w²) dw)."""
+def _spline_average(spline: AlbedoTable, grazing) -> np.ndarray:
+    """2∫₀¹ min(E, 1) μ dμ of the table and its grazing piece: 64 Gauss–Legendre nodes on
+    each piece in w (dμ = 4w(1 − w²) dw), the held value on [0, w(THETA_HOLD)]."""
     x, wt = np.polynomial.legendre.leggauss(64)
     total = 0.0
-    edges = np.concatenate([[0.0], spline.breaks])
+    edges = np.concatenate([[0.0, float(w_of_mu(math.cos(THETA_HOLD)))], spline.breaks])
     for lo, hi in zip(edges[:-1], edges[1:], strict=True):
         w = lo + (hi - lo) * 0.5 * (x + 1.0)
         mu = mu_of_w(w)
-        e = np.minimum(_spline_e(spline, mu), 1.0)
+        e = np.minimum(_spline_e(spline, grazing, mu), 1.0)
         jac = 4.0 * w * (1.0 - w * w) * (hi - lo) * 0.5
         total = total + np.sum((2.0 * mu * jac * wt)[:, None] * e, axis=0)
     return total
@@ -241,25 +265,29 @@ def compensation_table(model: BRDF, *, who: str = "compensate") -> CompensationT
     t0 = time.perf_counter()
     spline = build_albedo_table(model, tol=TABLE_TOL, engine_tol=ENGINE_TOL, margin=False,
                                 who=who)
-    max_albedo = spline.max_albedo
+    grazing, grazing_err, _ = _grazing_piece(model, spline)
+    max_albedo = np.maximum(spline.max_albedo, np.max(_as_2d(grazing(grazing.x)), axis=0))
     clamped = bool(np.any(max_albedo > 1.0))
-    # piece boundaries and where the extension is held (THETA_HOLD)
-    kinks = np.concatenate([mu_of_w(spline.breaks[1:-1]), [math.cos(THETA_HOLD)]])
+    # the pieces' boundaries (where the grazing piece meets the table, THETA_TOP) and where
+    # the value is held (THETA_HOLD)
+    kinks = np.concatenate([mu_of_w(spline.breaks[:-1]), [math.cos(THETA_HOLD)]])
     grid = np.linspace(0.0, 1.0, 4097)
     lookups = []
     for c in range(max_albedo.size):
         def e_of(mu, c=c):
-            e = _spline_e(spline, mu)[:, c:c + 1]
+            e = _spline_e(spline, grazing, mu)[:, c:c + 1]
             return np.clip(e, E_FLOOR, 1.0)  # clamp: see E_FLOOR and the docstring (E > 1)
         ks = kinks
         if clamped:  # where E crosses 1, the clamp makes a kink
-            ks = np.concatenate([ks, _crossings(lambda m, c=c: _spline_e(spline, m)[
-                :, c:c + 1] - 1.0, grid, _spline_e(spline, grid)[:, c:c + 1] - 1.0)])
+            ks = np.concatenate([ks, _crossings(lambda m, c=c: _spline_e(
+                spline, grazing, m)[:, c:c + 1] - 1.0, grid, _spline_e(
+                spline, grazing, grid)[:, c:c + 1] - 1.0)])
         lookups.append(build_lookup(e_of, kinks=ks, tol=LUT_TOL, bound="upper"))
     e_avg = np.array([_lookup_average(lk) for lk in lookups])
-    e_avg_error = np.abs(e_avg - _spline_average(spline))
+    e_avg_error = np.abs(e_avg - _spline_average(spline, grazing))
     return CompensationTable(
         spline=spline, lookups=tuple(lookups), e_avg=e_avg, e_avg_error=e_avg_error,
-        max_albedo=max_albedo, clamped=clamped, interp_error=spline.max_midpoint_error,
+        max_albedo=max_albedo, clamped=clamped,
+        interp_error=np.maximum(spline.max_midpoint_error, grazing_err),
         lookup_error=float(max(lk.max_error + lk.epsilon for lk in lookups)),
         engine_tol=ENGINE_TOL, seconds=time.perf_counter() - t0)
