@@ -16,6 +16,7 @@ One module per family; every model is registered in :data:`MODELS`.
   :mod:`~brdfkit.models.vgroove` — Torrance–Sparrow and Cook–Torrance;
   :mod:`~brdfkit.models.ward` — Ward; :mod:`~brdfkit.models.he_torrance` —
   He–Torrance–Sillion–Greenberg.
+- :mod:`~brdfkit.models.disney` — Burley's (2012) principled BRDF.
 
 Shared by the families: :mod:`~brdfkit.models.sampling` (importance-sampling
 strategies), :mod:`~brdfkit.models.specular` (Lewis's H_s),
@@ -31,6 +32,7 @@ from brdfkit.models._registry import MODELS, model, model_names, register, resol
 # isort: off
 from brdfkit.models import diffuse, phong, blinn, lafortune, grazing  # noqa: E402,F401,I001
 from brdfkit.models import microfacet, vgroove, ward, he_torrance  # noqa: E402,F401,I001
+from brdfkit.models import disney  # noqa: E402,F401,I001
 # isort: on
 
 __all__ = ["BRDF", "DerivedBRDF", "Lobe", "MODELS", "Param", "eval_pairs", "model", "model_names",

@@ -15,7 +15,8 @@ that Numba caches on disk (below).
 - :data:`LOOPS` — the loops the generator writes, each from one hand-written
   template: ``"checked"`` and ``"plain"`` (one pair per iteration, parallel over
   pairs), ``"vector"`` (chunks of pairs whose inner loop LLVM vectorises, for
-  branch-free total kernels such as the microfacet models'), ``"blocked"``
+  branch-free total kernels such as the microfacet models'), ``"rgb"`` (the same, for a
+  kernel computing three channels at once from all packed rows), ``"blocked"``
   (locate a block of pairs, then read them: table lookups), ``"albedo"`` (the
   albedo engine's serial loop over incident angles and outgoing nodes).
 - :func:`loop_driver` — the loop *loop* for one kernel with an importable name,
@@ -172,7 +173,9 @@ def eval_pairs_checked(kernel, wi, wo, P, out):  # pragma: no cover - compiled
 # AVX2); the directions are read as flat arrays (index 3j + k), which LLVM loads as
 # interleaved groups. Measured on 10 M pairs (microfacet, Beckmann α = 0.1): 2.3x the
 # checked loop on one thread. Templates only (plain functions, never compiled here):
-# `kernel` and `chunk` are the globals of each generated module.
+# `kernel` and `chunk` are the globals of each generated module. "rgb" is the same with
+# RGB = True: kernel(ix, iy, iz, ox, oy, oz, P) -> (f0, f1, f2) over the rows P (3, K), so
+# the work the channels share (Disney's D, G, diffuse shape) is done once per pair.
 def _vector_chunk(a, b, o, p):  # pragma: no cover - compiled in the generated modules
     # One channel of the pairs in a and b (flat, 3 per pair) into o; returns the
     # number of good pairs. What LLVM needs to vectorise this loop, each measured:
@@ -181,12 +184,18 @@ def _vector_chunk(a, b, o, p):  # pragma: no cover - compiled in the generated m
     # wraparound select, and the loads are no longer an interleaved group),
     # a unit-stride store, and the count as int64(ok) (not a select of 0 and 1).
     good = 0
-    for j in range(o.shape[0]):
+    for j in range(o.shape[-1]):
         ix, iy, iz = a[3 * j], a[3 * j + 1], a[3 * j + 2]
         ox, oy, oz = b[3 * j], b[3 * j + 1], b[3 * j + 2]
         ok = _unit_pair(ix, iy, iz, ox, oy, oz)
-        v = kernel(ix, iy, iz, ox, oy, oz, p)  # noqa: F821 - total: safe for any input
-        o[j] = v if ok else math.nan
+        if RGB:  # noqa: F821 - a constant: Numba prunes the branch not taken; p = P, o (3, m)
+            v0, v1, v2 = kernel(ix, iy, iz, ox, oy, oz, p)  # noqa: F821 - total
+            o[0, j] = v0 if ok else math.nan
+            o[1, j] = v1 if ok else math.nan
+            o[2, j] = v2 if ok else math.nan
+        else:
+            v = kernel(ix, iy, iz, ox, oy, oz, p)  # noqa: F821 - total: safe for any input
+            o[j] = v if ok else math.nan
         good += numba.int64(ok)
     return good
 
@@ -198,6 +207,15 @@ def _vector_loop(wi, wo, P, out):  # pragma: no cover - compiled in the generate
     b = wo.reshape(3 * n)
     n_chunks = (n + _CHUNK - 1) // _CHUNK
     n_good = 0
+    if RGB:  # noqa: F821 - one pass: the kernel computes the three channels together
+        for q in numba.prange(n_chunks):
+            lo = q * _CHUNK
+            hi = min(n, lo + _CHUNK)
+            o = np.empty((3, hi - lo))  # C-contiguous rows: unit-stride stores, vectorised
+            n_good += chunk(a[3 * lo:3 * hi], b[3 * lo:3 * hi], o, P)  # noqa: F821
+            for c in range(3):
+                out[lo:hi, c] = o[c]
+        return n - n_good
     if n_channels == 1:
         o = out.reshape(n)
         p = P[0]
@@ -293,7 +311,9 @@ LOOPS = {
     "plain": ((("driver", eval_pairs_checked, 'parallel=True, error_model="numpy"'),),
               {"CHECK": False}),
     "vector": ((("chunk", _vector_chunk, "**VECTOR_OPTIONS"),
-                ("driver", _vector_loop, "parallel=True, **VECTOR_OPTIONS")), {}),
+                ("driver", _vector_loop, "parallel=True, **VECTOR_OPTIONS")), {"RGB": False}),
+    "rgb": ((("chunk", _vector_chunk, "**VECTOR_OPTIONS"),
+             ("driver", _vector_loop, "parallel=True, **VECTOR_OPTIONS")), {"RGB": True}),
     "blocked": ((("driver", _blocked_loop, 'parallel=True, error_model="numpy"'),), {}),
     "albedo": ((("driver", _albedo_nodes, 'error_model="numpy"'),), {}),
 }
@@ -507,8 +527,9 @@ def _name(obj) -> str:
 
 
 def loop_driver(kernel, *, loop: str = "checked"):
-    """The loop *loop* (:data:`LOOPS`: ``"checked"``, ``"plain"``, ``"vector"``) for
-    *kernel*: ``driver(wi, wo, P, out) -> n_bad``.
+    """The loop *loop* (:data:`LOOPS`: ``"checked"``, ``"plain"``, ``"vector"``, ``"rgb"``)
+    for *kernel*: ``driver(wi, wo, P, out) -> n_bad`` (``"rgb"``: a kernel of the three
+    rows returning three channels, P (3, K), out (N, 3)).
 
     Generated as a module and cached on disk when the kernel has an importable name
     (the second process loads it in milliseconds); otherwise compiled in memory, the
