@@ -80,6 +80,7 @@ from pathlib import Path
 
 import numba
 import numpy as np
+from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from brdfkit._cache import bounded_cache, memo
 from brdfkit._threads import numba_threads  # noqa: F401  (re-exported)
@@ -173,22 +174,19 @@ def eval_pairs_checked(kernel, wi, wo, P, out):  # pragma: no cover - compiled
 # AVX2); the directions are read as flat arrays (index 3j + k), which LLVM loads as
 # interleaved groups. Measured on 10 M pairs (microfacet, Beckmann α = 0.1): 2.3x the
 # checked loop on one thread. Templates only (plain functions, never compiled here):
-# `kernel` and `chunk` are the globals of each generated module. "rgb" is the same with
-# RGB = True: kernel(ix, iy, iz, ox, oy, oz, P) -> (f0, f1, f2) over the rows P (3, K), so
-# the work the channels share (Disney's D, G, diffuse shape) is done once per pair.
+# `kernel` and `chunk` are the globals of each generated module. "rgb": the same with RGB =
+# True, kernel(…, t) -> (f0, f1, f2) over the rows as one tuple: shared work done once.
 def _vector_chunk(a, b, o, p):  # pragma: no cover - compiled in the generated modules
-    # One channel of the pairs in a and b (flat, 3 per pair) into o; returns the
-    # number of good pairs. What LLVM needs to vectorise this loop, each measured:
-    # its own function (inside the prange body Numba keeps the loop's variables
-    # live after it), indices from 0 (a signed start needs the negative-index
-    # wraparound select, and the loads are no longer an interleaved group),
-    # a unit-stride store, and the count as int64(ok) (not a select of 0 and 1).
+    # The pairs in a and b (flat, 3 per pair) into o; returns the number of good pairs.
+    # LLVM vectorises it given (each measured): its own function (in a prange body Numba keeps
+    # the loop's variables live), indices from 0 (no wraparound select; the loads stay an
+    # interleaved group), unit-stride stores, the count as int64(ok), no loads of p (RGB).
     good = 0
     for j in range(o.shape[-1]):
         ix, iy, iz = a[3 * j], a[3 * j + 1], a[3 * j + 2]
         ox, oy, oz = b[3 * j], b[3 * j + 1], b[3 * j + 2]
         ok = _unit_pair(ix, iy, iz, ox, oy, oz)
-        if RGB:  # noqa: F821 - a constant: Numba prunes the branch not taken; p = P, o (3, m)
+        if RGB:  # noqa: F821 - a constant: Numba prunes the branch not taken; o (3, m)
             v0, v1, v2 = kernel(ix, iy, iz, ox, oy, oz, p)  # noqa: F821 - total
             o[0, j] = v0 if ok else math.nan
             o[1, j] = v1 if ok else math.nan
@@ -207,12 +205,13 @@ def _vector_loop(wi, wo, P, out):  # pragma: no cover - compiled in the generate
     b = wo.reshape(3 * n)
     n_chunks = (n + _CHUNK - 1) // _CHUNK
     n_good = 0
-    if RGB:  # noqa: F821 - one pass: the kernel computes the three channels together
+    if RGB:  # noqa: F821 - the rows as one tuple of WIDTH = 3 K: no loads in the loop
+        t = to_fixed_tuple(P.reshape(P.size), WIDTH)  # noqa: F821
         for q in numba.prange(n_chunks):
             lo = q * _CHUNK
             hi = min(n, lo + _CHUNK)
-            o = np.empty((3, hi - lo))  # C-contiguous rows: unit-stride stores, vectorised
-            n_good += chunk(a[3 * lo:3 * hi], b[3 * lo:3 * hi], o, P)  # noqa: F821
+            o = np.empty((3, hi - lo))  # C-contiguous rows: unit-stride stores
+            n_good += chunk(a[3 * lo:3 * hi], b[3 * lo:3 * hi], o, t)  # noqa: F821
             for c in range(3):
                 out[lo:hi, c] = o[c]
         return n - n_good
@@ -383,11 +382,12 @@ import math
 import numba
 import numpy as np
 
-from brdfkit.models._drivers import _CHUNK, VECTOR_OPTIONS, _compose, _unit_pair
+from brdfkit.models._drivers import (_CHUNK, VECTOR_OPTIONS, _compose, _unit_pair,
+                                     to_fixed_tuple)
 '''
 # the globals every generated loop reads, for the loops compiled in memory
-_LOOP_GLOBALS = {"math": math, "numba": numba, "np": np, "_unit_pair": _unit_pair,
-                 "_CHUNK": _CHUNK, "VECTOR_OPTIONS": VECTOR_OPTIONS}
+_LOOP_GLOBALS = {"math": math, "numba": numba, "np": np, "_unit_pair": _unit_pair, "_CHUNK": _CHUNK,
+                 "VECTOR_OPTIONS": VECTOR_OPTIONS, "to_fixed_tuple": to_fixed_tuple}
 
 #: memo key -> (what it was built from, result): the entry holds what it was built from, so
 #: an id() in a key stays that object's while the entry lives; one entry per kernel, loop
@@ -526,17 +526,17 @@ def _name(obj) -> str:
     return f"{py.__module__}.{py.__qualname__}"
 
 
-def loop_driver(kernel, *, loop: str = "checked"):
+def loop_driver(kernel, *, loop: str = "checked", width: int = 0):
     """The loop *loop* (:data:`LOOPS`: ``"checked"``, ``"plain"``, ``"vector"``, ``"rgb"``)
-    for *kernel*: ``driver(wi, wo, P, out) -> n_bad`` (``"rgb"``: a kernel of the three
-    rows returning three channels, P (3, K), out (N, 3)).
+    for *kernel*: ``driver(wi, wo, P, out) -> n_bad`` (``"rgb"``: P (3, K) passed to the
+    kernel as the flat tuple of its *width* = 3 K values, three channels out, (N, 3)).
 
-    Generated as a module and cached on disk when the kernel has an importable name
-    (the second process loads it in milliseconds); otherwise compiled in memory, the
-    same code. Memoised per kernel and loop.
+    Generated as a module and cached on disk when the kernel has an importable name (the
+    second process loads it in milliseconds); else compiled in memory. Memoised.
     """
-    return _memo((id(kernel), loop), lambda: (kernel, _generate(
-        f"kernel {_name(kernel)}", loop, {"kernel": kernel})["driver"]))
+    bound = {"kernel": kernel, **({"WIDTH": int(width)} if width else {})}
+    return _memo((id(kernel), loop, width), lambda: (kernel, _generate(
+        f"kernel {_name(kernel)}", loop, bound)["driver"]))
 
 
 def blocked_driver(*, state, pair, emit, block: int):

@@ -282,21 +282,17 @@ def _principled(ix, iy, iz, ox, oy, oz, p):
 
 
 @numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
-def _principled_rgb(ix, iy, iz, ox, oy, oz, P):  # pragma: no cover - compiled
-    """The three channels at once over the packed rows P (3, K) (the ``"rgb"`` loop of
-    :mod:`brdfkit.models._drivers`): the shared terms once, then each channel as
-    :func:`principled` computes it (the same operations: bit-equal). The shared columns
-    are read as a tuple: a row view P[0] would be a new array (reference-counted) per
-    pair, which keeps LLVM from vectorising the loop."""
-    shared = (0.0, 0.0, 0.0, P[0, P_ROUGH], P[0, P_SUB], P[0, P_IAX2], P[0, P_IAY2],
-              P[0, P_AX], P[0, P_AY], P[0, P_KDS], P[0, P_KCC], P[0, P_A2CC])
-    live, diffuse, f_h, gd_s, coat = principled_terms(ix, iy, iz, ox, oy, oz, shared)
-    return (principled_channel(P[0, P_KD], P[0, P_KSH], P[0, P_CS0], live, diffuse, f_h,
-                               gd_s, coat),
-            principled_channel(P[1, P_KD], P[1, P_KSH], P[1, P_CS0], live, diffuse, f_h,
-                               gd_s, coat),
-            principled_channel(P[2, P_KD], P[2, P_KSH], P[2, P_CS0], live, diffuse, f_h,
-                               gd_s, coat))
+def _principled_rgb(ix, iy, iz, ox, oy, oz, t):  # pragma: no cover - compiled
+    """The three channels at once (the ``"rgb"`` loop of :mod:`brdfkit.models._drivers`)
+    over *t*, the three packed rows as one flat tuple (t[c·N_PACKED + k]): the shared terms
+    once, then each channel as :func:`principled` computes it (the same operations:
+    bit-equal)."""
+    live, diffuse, f_h, gd_s, coat = principled_terms(ix, iy, iz, ox, oy, oz, t)
+    return (principled_channel(t[P_KD], t[P_KSH], t[P_CS0], live, diffuse, f_h, gd_s, coat),
+            principled_channel(t[N_PACKED + P_KD], t[N_PACKED + P_KSH], t[N_PACKED + P_CS0],
+                               live, diffuse, f_h, gd_s, coat),
+            principled_channel(t[2 * N_PACKED + P_KD], t[2 * N_PACKED + P_KSH],
+                               t[2 * N_PACKED + P_CS0], live, diffuse, f_h, gd_s, coat))
 
 
 # --------------------------------------------------------------------------- sampling
@@ -510,7 +506,7 @@ class Disney(StrategySampled, BRDF):
         self.isotropic = v["anisotropic"] == 0.0
         # BRDF.eval's loop (generated, cached on disk): RGB in one pass of the shared terms
         # (the "rgb" loop), else the vectorised loop of the one-channel kernel
-        self._driver = (loop_driver(_principled_rgb, loop="rgb") if c == 3
+        self._driver = (loop_driver(_principled_rgb, loop="rgb", width=3 * N_PACKED) if c == 3
                         else loop_driver(_principled, loop="vector"))
 
     # ------------------------------------------------------------- derived constants
