@@ -182,15 +182,15 @@ def _vector_chunk(a, b, o, p):  # pragma: no cover - compiled in the generated m
     # the loop's variables live), indices from 0 (no wraparound select; the loads stay an
     # interleaved group), unit-stride stores, the count as int64(ok), no loads of p (RGB).
     good = 0
-    for j in range(o.shape[-1]):
+    for j in range(o.shape[0] // (3 if RGB else 1)):  # noqa: F821
         ix, iy, iz = a[3 * j], a[3 * j + 1], a[3 * j + 2]
         ox, oy, oz = b[3 * j], b[3 * j + 1], b[3 * j + 2]
         ok = _unit_pair(ix, iy, iz, ox, oy, oz)
-        if RGB:  # noqa: F821 - a constant: Numba prunes the branch not taken; o (3, m)
+        if RGB:  # noqa: F821 - a constant: Numba prunes the branch not taken; o: (m, 3) flat
             v0, v1, v2 = kernel(ix, iy, iz, ox, oy, oz, p)  # noqa: F821 - total
-            o[0, j] = v0 if ok else math.nan
-            o[1, j] = v1 if ok else math.nan
-            o[2, j] = v2 if ok else math.nan
+            o[3 * j] = v0 if ok else math.nan  # an interleaved store group
+            o[3 * j + 1] = v1 if ok else math.nan
+            o[3 * j + 2] = v2 if ok else math.nan
         else:
             v = kernel(ix, iy, iz, ox, oy, oz, p)  # noqa: F821 - total: safe for any input
             o[j] = v if ok else math.nan
@@ -207,13 +207,11 @@ def _vector_loop(wi, wo, P, out):  # pragma: no cover - compiled in the generate
     n_good = 0
     if RGB:  # noqa: F821 - the rows as one tuple of WIDTH = 3 K: no loads in the loop
         t = to_fixed_tuple(P.reshape(P.size), WIDTH)  # noqa: F821
+        o = out.reshape(3 * n)
         for q in numba.prange(n_chunks):
             lo = q * _CHUNK
             hi = min(n, lo + _CHUNK)
-            o = np.empty((3, hi - lo))  # C-contiguous rows: unit-stride stores
-            n_good += chunk(a[3 * lo:3 * hi], b[3 * lo:3 * hi], o, t)  # noqa: F821
-            for c in range(3):
-                out[lo:hi, c] = o[c]
+            n_good += chunk(a[3 * lo:3 * hi], b[3 * lo:3 * hi], o[3 * lo:3 * hi], t)  # noqa: F821
         return n - n_good
     if n_channels == 1:
         o = out.reshape(n)
