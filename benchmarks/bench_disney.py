@@ -116,7 +116,8 @@ def main(argv=None) -> int:
         for label, params in SETS.items():
             model = brdfkit.model("disney", **params)
             mit = make_mitsuba(params)
-            fns = {"brdfkit": lambda m=model: m.eval(wi, wo), "mitsuba": lambda r=mit: r(wi, wo)}
+            fns = {"brdfkit": lambda m=model, a=wi, b=wo: m.eval(a, b),
+                   "mitsuba": lambda r=mit, a=wi, b=wo: r(a, b)}
             for fn in fns.values():
                 fn()  # warm-up: compile/trace, first-touch allocations
             times = {k: [] for k in fns}

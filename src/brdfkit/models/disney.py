@@ -113,8 +113,19 @@ import math
 import numba
 import numpy as np
 
-from brdfkit._dual import Formulas, absolute, cos, exp, formula, log, maximum, minimum, select
-from brdfkit._dual import sin, sqrt
+from brdfkit._dual import (
+    Formulas,
+    absolute,
+    cos,
+    exp,
+    formula,
+    log,
+    maximum,
+    minimum,
+    select,
+    sin,
+    sqrt,
+)
 from brdfkit.errors import ParameterError
 from brdfkit.halfangle import beta_from_trowbridge_reitz_c
 from brdfkit.models._base import BRDF, VECTOR_OPTIONS, Lobe, Param
