@@ -68,9 +68,9 @@ products of one factor per direction with the symmetric F_D90(cos θ_d), f_ss de
 cos θ_l + cos θ_v, D and F_H on h, G on one factor per direction — although Burley does
 not claim it (the notes aim for plausibility, not a proof). **Isotropic** only when
 anisotropic = 0 (per instance). **Energy**: not claimed (nor by Burley): the diffuse
-retro-reflection and the subsurface term exceed a Lambertian's albedo at grazing
-incidence on rough surfaces (``tests/test_disney.py`` measures it), and single-scattering
-GGX loses energy at high roughness.
+retro-reflection exceeds a Lambertian's albedo (white, roughness 1: 1 + 1/28 at normal
+incidence, 1.52 at 89°, ``tests/test_disney.py``), so does the subsurface term at grazing
+incidence, and single-scattering GGX loses energy at high roughness.
 
 Guidance: keep base_color a display colour (it is linearised); roughness 0.3–0.6 for
 most dielectrics; metallic 0 or 1 (intermediate values blend); use anisotropic with a
