@@ -98,7 +98,7 @@ INF = math.inf
 
 @formula
 def walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
-    """F D G₁(ω_i) G₁(ω_o)/(4 cos θ_i cos θ_o), Walter eq. (20): one basic block.
+    """F D G₁(ω_i) G₁(ω_o) / (4 cos θ_i cos θ_o), Walter eq. (20): one basic block.
 
     A formula (:mod:`brdfkit._dual`): the compiled kernels below and the
     Mitsuba bridge's traced BSDF are this one function. Branch-free and total
@@ -111,20 +111,26 @@ def walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
     ω_i·h = ω_o·h = |s|/2 (unit vectors). When every component of s is below
     SMALL_LENGTH (both directions within 1e-140 of the horizon) their squares
     underflow: s is first multiplied by 2^600 (a select; exact; in the common case
-    the factor is exactly 1).
+    the factor is exactly 1). The channel-independent part is :func:`walter_terms`,
+    the channel's :func:`walter_channel` (the RGB kernel calls the first once).
     """
     # all parameters read first (vectorises)
     alpha, eta, k, scale = p[P_ALPHA], p[P_ETA], p[P_K], p[P_SCALE]
+    live, c, v = walter_terms(ix, iy, iz, ox, oy, oz, alpha, ggx)
+    return walter_channel(live, c, v, eta, k, scale, fresnel)
+
+
+@formula
+def walter_terms(ix, iy, iz, ox, oy, oz, alpha, ggx):
+    """(live, c, v) of :func:`walter`: f_r = select(live, scale · F(c) · v, 0) with
+    v = D G₁ G₁/(4 cos θ_i cos θ_o) and c = ω_i·h (1 where not live: F finite)."""
     inv_a2 = 1.0 / (alpha * alpha)
     live = (iz > 0.0) & (oz > 0.0)  # 0 at and below the horizon
     sx, sy, sz, small = half_sum(ix, iy, iz, ox, oy, oz)
     sxy2 = sx * sx + sy * sy
     sz2 = sz * sz
     l2 = sxy2 + sz2
-    if fresnel:
-        f = _fresnel_conductor(select(live, cos_d_of(l2, small), 1.0), eta, k)  # 1.0: finite
-    else:
-        f = 1.0
+    c = select(live, cos_d_of(l2, small), 1.0)  # 1.0: F finite where not live
     if ggx:
         inv_l2 = 1.0 / l2
         d = d_ggx_of_h(sz2 * inv_l2, sxy2 * inv_l2, inv_a2, alpha)
@@ -134,6 +140,17 @@ def walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
         live = live & (v < INF)  # 1/α² = inf (α < 1e-154) off the mirror: D = 0
     else:
         v = beckmann_dg_over_cos(iz, oz, sxy2, sz2, alpha, inv_a2, live)
+    return live, c, v
+
+
+@formula
+def walter_channel(live, c, v, eta, k, scale, fresnel):
+    """One channel of f_r from :func:`walter_terms` (or the anisotropic ones): scale ·
+    F_conductor(c; η, κ) · v (F = 1 unless *fresnel*), 0 where not live."""
+    if fresnel:
+        f = _fresnel_conductor(c, eta, k)
+    else:
+        f = 1.0
     return select(live, scale * f * v, 0.0)
 
 
@@ -176,6 +193,43 @@ def _walter_ggx(ix, iy, iz, ox, oy, oz, p):
 @formula(**VECTOR_OPTIONS)
 def _walter_ggx_f(ix, iy, iz, ox, oy, oz, p):
     return walter(ix, iy, iz, ox, oy, oz, p, True, True)
+
+
+# The three channels at once (the "rgb" loop of models/_drivers.py), over t, the three
+# packed rows as one flat tuple (t[c·N_PACKED + k]): walter_terms once, then each channel as
+# walter computes it (the same operations: bit-equal to the per-channel kernels).
+N_PACKED = len(PARAMS)
+
+
+@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+def walter_rgb(ix, iy, iz, ox, oy, oz, t, ggx, fresnel):  # pragma: no cover - compiled
+    """(f_R, f_G, f_B) of :func:`walter` over the flat tuple *t* of the three rows."""
+    live, c, v = walter_terms(ix, iy, iz, ox, oy, oz, t[P_ALPHA], ggx)
+    return (walter_channel(live, c, v, t[P_ETA], t[P_K], t[P_SCALE], fresnel),
+            walter_channel(live, c, v, t[N_PACKED + P_ETA], t[N_PACKED + P_K],
+                           t[N_PACKED + P_SCALE], fresnel),
+            walter_channel(live, c, v, t[2 * N_PACKED + P_ETA], t[2 * N_PACKED + P_K],
+                           t[2 * N_PACKED + P_SCALE], fresnel))
+
+
+@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+def _walter_beckmann_rgb(ix, iy, iz, ox, oy, oz, t):  # pragma: no cover - compiled
+    return walter_rgb(ix, iy, iz, ox, oy, oz, t, False, False)
+
+
+@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+def _walter_beckmann_f_rgb(ix, iy, iz, ox, oy, oz, t):  # pragma: no cover - compiled
+    return walter_rgb(ix, iy, iz, ox, oy, oz, t, False, True)
+
+
+@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+def _walter_ggx_rgb(ix, iy, iz, ox, oy, oz, t):  # pragma: no cover - compiled
+    return walter_rgb(ix, iy, iz, ox, oy, oz, t, True, False)
+
+
+@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+def _walter_ggx_f_rgb(ix, iy, iz, ox, oy, oz, t):  # pragma: no cover - compiled
+    return walter_rgb(ix, iy, iz, ox, oy, oz, t, True, True)
 
 
 @numba.njit(cache=True, **VECTOR_OPTIONS)
@@ -260,6 +314,8 @@ def _pdf_beckmann(ix, iy, iz, ox, oy, oz, alpha):
 
 _WALTER_KERNELS = {(False, False): _walter_beckmann, (False, True): _walter_beckmann_f,
                    (True, False): _walter_ggx, (True, True): _walter_ggx_f}
+_WALTER_RGB = {(False, False): _walter_beckmann_rgb, (False, True): _walter_beckmann_f_rgb,
+               (True, False): _walter_ggx_rgb, (True, True): _walter_ggx_f_rgb}
 
 
 @numba.njit(cache=True, **VECTOR_OPTIONS)
@@ -361,9 +417,13 @@ class Microfacet(BRDF):
             raise ParameterError(
                 f"{self.name}: k needs eta: give eta (the real part of the index) or drop k")
         # BRDF.eval's loop: the vectorised loop of this instance's (distribution, Fresnel)
-        # kernel, generated and cached on disk on first use (models/_drivers.py)
-        kernel = _WALTER_KERNELS[(v["distribution"] == "ggx", v["eta"] is not None)]
-        self._driver = loop_driver(kernel, loop="vector")
+        # kernel, generated and cached on disk on first use (models/_drivers.py); RGB: the
+        # "rgb" loop (D G₁ G₁ once per pair, three Fresnel factors)
+        key = (v["distribution"] == "ggx", v["eta"] is not None)
+        if self.n_channels == 3:
+            self._driver = loop_driver(_WALTER_RGB[key], loop="rgb", width=3 * N_PACKED)
+        else:
+            self._driver = loop_driver(_WALTER_KERNELS[key], loop="vector")
 
     def lobes(self):
         return [Lobe("half", float(self._values["alpha"]))]

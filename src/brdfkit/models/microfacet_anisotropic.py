@@ -56,7 +56,6 @@ import numpy as np
 
 from brdfkit._dual import Formulas, formula, maximum, select, sqrt
 from brdfkit.errors import ParameterError
-from brdfkit.fresnel import _fresnel_conductor
 from brdfkit.models._base import BRDF, VECTOR_OPTIONS, Lobe, Param
 from brdfkit.models._drivers import loop_driver
 from brdfkit.models._params import ETA, eta_fresnel_split, packed_indices
@@ -68,7 +67,12 @@ from brdfkit.models.anisotropic_distributions import (
     r2_of,
     sample_half_anisotropic,
 )
-from brdfkit.models.microfacet import cos_d_of, half_sum, reflection_jacobian
+from brdfkit.models.microfacet import (
+    cos_d_of,
+    half_sum,
+    reflection_jacobian,
+    walter_channel,
+)
 from brdfkit.models.microfacet_distributions import (
     _beckmann_g1_over_cos_r,
     beckmann_dg_core,
@@ -106,19 +110,26 @@ def walter_anisotropic(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
     Walter eq. (20) as :func:`~brdfkit.models.microfacet.walter` computes it (s = ω_i + ω_o
     rescaled when short, ω·h = |s|/2, no 1 − cos²), with q = (s_x/α_x)² + (s_y/α_y)²:
     GGX D = 1/(π α_x α_y ((s_z² + q)/|s|²)²), Beckmann's exponent −q/s_z², and G₁/cos
-    from r² = α_x² ω_x² + α_y² ω_y² per direction. Branch-free and total.
+    from r² = α_x² ω_x² + α_y² ω_y² per direction. Branch-free and total. The
+    channel-independent part is :func:`walter_anisotropic_terms`, the channel's
+    :func:`~brdfkit.models.microfacet.walter_channel` (the RGB kernel calls the first once).
     """
     ax, ay, eta, k, scale = p[P_AX], p[P_AY], p[P_ETA], p[P_K], p[P_SCALE]
+    live, c, v = walter_anisotropic_terms(ix, iy, iz, ox, oy, oz, ax, ay, ggx)
+    return walter_channel(live, c, v, eta, k, scale, fresnel)
+
+
+@formula
+def walter_anisotropic_terms(ix, iy, iz, ox, oy, oz, ax, ay, ggx):
+    """(live, c, v) of :func:`walter_anisotropic`: f_r = select(live, scale · F(c) · v, 0),
+    v = D G₁ G₁/(4 cos θ_i cos θ_o), c = ω_i·h (1 where not live: F finite)."""
     live = (iz > 0.0) & (oz > 0.0)  # 0 at and below the horizon
     sx, sy, sz, small = half_sum(ix, iy, iz, ox, oy, oz)
     sxy2 = sx * sx + sy * sy
     sz2 = sz * sz
     l2 = sxy2 + sz2
     q = q_of(sx, sy, ax, ay)
-    if fresnel:
-        f = _fresnel_conductor(select(live, cos_d_of(l2, small), 1.0), eta, k)  # 1.0: finite
-    else:
-        f = 1.0
+    c = select(live, cos_d_of(l2, small), 1.0)  # 1.0: F finite where not live
     ri2 = r2_of(ix, iy, ax, ay)
     ro2 = r2_of(ox, oy, ax, ay)
     if ggx:
@@ -130,7 +141,7 @@ def walter_anisotropic(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
         ni, di = _beckmann_g1_over_cos_r(iz, sqrt(ri2))
         no, do = _beckmann_g1_over_cos_r(oz, sqrt(ro2))
         v = beckmann_dg_core(sxy2 / sz2, -q / sz2, ax * ay, ni, di, no, do, live)
-    return select(live, scale * f * v, 0.0)
+    return live, c, v
 
 
 @formula(**VECTOR_OPTIONS)
@@ -155,6 +166,47 @@ def _ggx_f(ix, iy, iz, ox, oy, oz, p):
 
 _KERNELS = {(False, False): _beckmann, (False, True): _beckmann_f, (True, False): _ggx,
             (True, True): _ggx_f}
+
+
+# The three channels at once (the "rgb" loop of models/_drivers.py) over t, the three
+# packed rows as one flat tuple (t[c·N_PACKED + k]): the terms once, then each channel as
+# walter_anisotropic computes it (the same operations: bit-equal to the per-channel kernels).
+N_PACKED = len(PARAMS)
+
+
+@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+def walter_anisotropic_rgb(ix, iy, iz, ox, oy, oz, t, ggx, fresnel):  # pragma: no cover
+    """(f_R, f_G, f_B) of :func:`walter_anisotropic` over the flat tuple *t* of the rows."""
+    live, c, v = walter_anisotropic_terms(ix, iy, iz, ox, oy, oz, t[P_AX], t[P_AY], ggx)
+    return (walter_channel(live, c, v, t[P_ETA], t[P_K], t[P_SCALE], fresnel),
+            walter_channel(live, c, v, t[N_PACKED + P_ETA], t[N_PACKED + P_K],
+                           t[N_PACKED + P_SCALE], fresnel),
+            walter_channel(live, c, v, t[2 * N_PACKED + P_ETA], t[2 * N_PACKED + P_K],
+                           t[2 * N_PACKED + P_SCALE], fresnel))
+
+
+@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+def _beckmann_rgb(ix, iy, iz, ox, oy, oz, t):  # pragma: no cover - compiled
+    return walter_anisotropic_rgb(ix, iy, iz, ox, oy, oz, t, False, False)
+
+
+@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+def _beckmann_f_rgb(ix, iy, iz, ox, oy, oz, t):  # pragma: no cover - compiled
+    return walter_anisotropic_rgb(ix, iy, iz, ox, oy, oz, t, False, True)
+
+
+@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+def _ggx_rgb(ix, iy, iz, ox, oy, oz, t):  # pragma: no cover - compiled
+    return walter_anisotropic_rgb(ix, iy, iz, ox, oy, oz, t, True, False)
+
+
+@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+def _ggx_f_rgb(ix, iy, iz, ox, oy, oz, t):  # pragma: no cover - compiled
+    return walter_anisotropic_rgb(ix, iy, iz, ox, oy, oz, t, True, True)
+
+
+_RGB_KERNELS = {(False, False): _beckmann_rgb, (False, True): _beckmann_f_rgb,
+                (True, False): _ggx_rgb, (True, True): _ggx_f_rgb}
 
 
 @numba.njit(cache=True, **VECTOR_OPTIONS)
@@ -239,8 +291,13 @@ class MicrofacetAnisotropic(StrategySampled, BRDF):
         if v["eta"] is None and np.any(np.asarray(v["k"]) != 0.0):
             raise ParameterError(
                 f"{self.name}: k needs eta: give eta (the real part of the index) or drop k")
-        # BRDF.eval's loop: the vectorised loop of this instance's (distribution, Fresnel)
-        self._driver = loop_driver(self._kernel(), loop="vector")
+        # BRDF.eval's loop: the vectorised loop of this instance's (distribution, Fresnel);
+        # RGB: the "rgb" loop (D G₁ G₁ once per pair, three Fresnel factors)
+        if self.n_channels == 3:
+            key = (v["distribution"] == "ggx", v["eta"] is not None)
+            self._driver = loop_driver(_RGB_KERNELS[key], loop="rgb", width=3 * N_PACKED)
+        else:
+            self._driver = loop_driver(self._kernel(), loop="vector")
 
     def _kernel(self):
         v = self._values
