@@ -8,13 +8,18 @@ end — NumPy arrays in, NumPy array out — side by side, rows interleaved per 
 that a change of the machine's load hits both:
 
 - brdfkit ``microfacet-anisotropic`` (GGX, α_x = 0.1, α_y = 0.4): ``model.eval(wi, wo)``,
-  with F = 1 ((N,) float64) and with a conductor's RGB η, κ ((N, 3) float64);
-- Mitsuba 3 ``roughconductor`` (GGX, ``alpha_u`` = 0.1, ``alpha_v`` = 0.4; ``material
-  = "none"`` for F = 1, else the same η, κ), variant ``llvm_ad_rgb``: NumPy float64 →
-  float32 ``mi.Vector3f`` → ``SurfaceInteraction3f`` → ``BSDF.eval`` → ``Color3f`` →
-  NumPy, all timed (its eval is f_r·cos θ: one multiply more, not removed).
+  with F = 1 ((N,) float64) and with a conductor's RGB η, κ ((N, 3) float64: the ``"rgb"``
+  loop, D G₁ G₁ once per pair); and the isotropic ``microfacet`` (GGX, α = 0.2) with the
+  same RGB conductor (case ``iso cond``);
+- Mitsuba 3 ``roughconductor`` (GGX, ``alpha_u`` = 0.1, ``alpha_v`` = 0.4, or
+  ``alpha`` = 0.2; ``material = "none"`` for F = 1, else the same η, κ), variant
+  ``llvm_ad_rgb``: NumPy float64 → float32 ``mi.Vector3f`` → ``SurfaceInteraction3f`` →
+  ``BSDF.eval`` → ``Color3f`` → NumPy, all timed (its eval is f_r·cos θ: one multiply
+  more, not removed).
 
-The ratio column is brdfkit's rate over Mitsuba's for the same case (target ≥ 1.2). Before
+The ratio column is brdfkit's rate over Mitsuba's for the same case (target ≥ 1.2); for the
+RGB cases the table also gives the rate of the per-channel vector loop of the same kernel
+(what ``model.eval`` ran before the ``"rgb"`` loop: D and G₁ per channel). Before
 timing, the agreement of the two is printed (relative difference of f_r·cos θ on 10⁵
 pairs: float32 against float64). The CPU model (``lscpu``) and the load average before
 and after are printed: the numbers compare only within one run.
@@ -38,6 +43,7 @@ import numpy as np
 from bench_eval import probe_mitsuba_llvm, random_pairs
 
 AX, AY = 0.1, 0.4
+ALPHA = 0.2  # the isotropic case
 ETA, K = [0.2, 0.9, 1.1], [3.9, 2.4, 2.2]
 
 
@@ -52,6 +58,16 @@ def cpu_model() -> str:
     return "unknown"
 
 
+def per_channel_kernel(model):
+    """The per-channel kernel of *model*'s instance (what the engines and Mitsuba use)."""
+    from brdfkit.models import microfacet
+
+    if model.name == "microfacet":
+        v = model.values
+        return microfacet._WALTER_KERNELS[(v["distribution"] == "ggx", v["eta"] is not None)]
+    return model._kernel()
+
+
 def make_mitsuba():
     """{case: bsdf} and run(bsdf, wi, wo) -> (3, N) f_r cos θ in NumPy (llvm_ad_rgb)."""
     import drjit as dr
@@ -62,7 +78,11 @@ def make_mitsuba():
             "sample_visible": False}
     bsdfs = {"F = 1": mi.load_dict({**base, "material": "none"}),
              "conductor": mi.load_dict({**base, "eta": {"type": "rgb", "value": ETA},
-                                        "k": {"type": "rgb", "value": K}})}
+                                        "k": {"type": "rgb", "value": K}}),
+             "iso cond": mi.load_dict({"type": "roughconductor", "distribution": "ggx",
+                                       "alpha": ALPHA, "sample_visible": False,
+                                       "eta": {"type": "rgb", "value": ETA},
+                                       "k": {"type": "rgb", "value": K}})}
     ctx = mi.BSDFContext()
 
     def run(bsdf, wi, wo):
@@ -88,6 +108,7 @@ def main(argv=None) -> int:
     import numba
 
     import brdfkit
+    from brdfkit.models._drivers import loop_driver
 
     print(f"CPU: {cpu_model()}; {os.cpu_count()} CPUs; Numba {numba.__version__} "
           f"({numba.get_num_threads()} threads), NumPy {np.__version__}")
@@ -100,7 +121,9 @@ def main(argv=None) -> int:
     models = {"F = 1": brdfkit.model("microfacet-anisotropic", distribution="ggx",
                                      alpha_x=AX, alpha_y=AY),
               "conductor": brdfkit.model("microfacet-anisotropic", distribution="ggx",
-                                         alpha_x=AX, alpha_y=AY, eta=ETA, k=K)}
+                                         alpha_x=AX, alpha_y=AY, eta=ETA, k=K),
+              "iso cond": brdfkit.model("microfacet", distribution="ggx", alpha=ALPHA,
+                                        eta=ETA, k=K)}
 
     # agreement (f_r cos θ of the light), and the axes: alpha_u is α_x
     wi, wo = random_pairs(100_000, args.seed + 1)
@@ -116,9 +139,14 @@ def main(argv=None) -> int:
     for n in args.pairs:
         wi, wo = random_pairs(n, args.seed)
         jobs = {}
-        for case in models:
-            jobs[("brdfkit", case)] = lambda m=models[case], a=wi, b=wo: m.eval(a, b)
+        for case, m in models.items():
+            jobs[("brdfkit", case)] = lambda m=m, a=wi, b=wo: m.eval(a, b)
             jobs[("Mitsuba", case)] = lambda f=bsdfs[case], a=wi, b=wo: run(f, a, b)
+            if m.n_channels == 3:  # the per-channel loop of the same kernel, for reference
+                drive = loop_driver(per_channel_kernel(m), loop="vector")
+                rows3 = m.packed.copy()
+                jobs[("per-channel", case)] = lambda d=drive, p=rows3, a=wi, b=wo: d(
+                    a, b, p, np.empty((len(a), 3)))  # allocated per call, as eval does
         times = {key: [] for key in jobs}
         for fn in jobs.values():
             fn()  # warm-up (Numba loads, Dr.Jit compiles its kernel)
@@ -130,15 +158,19 @@ def main(argv=None) -> int:
         for case in models:
             tb = statistics.median(times[("brdfkit", case)])
             tm = statistics.median(times[("Mitsuba", case)])
-            rows.append((n, case, tb, tm))
+            tp = times.get(("per-channel", case))
+            rows.append((n, case, tb, tm, statistics.median(tp) if tp else None))
 
     print()
     print(f"| {'pairs':>10} | {'case':<9} | {'brdfkit M/s':>11} | {'Mitsuba M/s':>11} | "
-          f"{'brdfkit (s)':>11} | {'Mitsuba (s)':>11} | {'brdfkit/Mitsuba':>15} |")
-    print(f"|{'-' * 12}|{'-' * 11}|{'-' * 13}|{'-' * 13}|{'-' * 13}|{'-' * 13}|{'-' * 17}|")
-    for n, case, tb, tm in rows:
+          f"{'brdfkit (s)':>11} | {'Mitsuba (s)':>11} | {'brdfkit/Mitsuba':>15} | "
+          f"{'per-channel M/s':>15} |")
+    print(f"|{'-' * 12}|{'-' * 11}|{'-' * 13}|{'-' * 13}|{'-' * 13}|{'-' * 13}|{'-' * 17}|"
+          f"{'-' * 17}|")
+    for n, case, tb, tm, tp in rows:
+        per = f"{n / tp / 1e6:15.1f}" if tp else f"{'':>15}"
         print(f"| {n:>10,} | {case:<9} | {n / tb / 1e6:11.1f} | {n / tm / 1e6:11.1f} | "
-              f"{tb:11.4f} | {tm:11.4f} | {tm / tb:14.2f}x |")
+              f"{tb:11.4f} | {tm:11.4f} | {tm / tb:14.2f}x | {per} |")
     print()
     print("load average (1, 5, 15 min): {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     return 0
