@@ -14,7 +14,10 @@ Public objects
   separable Smith masking, conductor Fresnel; its kernel is branch-free and
   runs in the vectorised loop (:func:`~brdfkit.models._drivers.loop_driver`,
   ``loop="vector"``).
-- :func:`walter`, :func:`walter_sample`, :func:`walter_pdf` — its formulas;
+- :func:`walter`, :func:`walter_sample`, :func:`walter_pdf` — its formulas; :func:`walter`
+  is :func:`walter_terms` (D G₁ G₁, the channel-independent part) and
+  :func:`walter_channel` (F and the scale), which :func:`walter_rgb` (three channels in the
+  ``"rgb"`` loop, bit-equal per channel) calls once and thrice;
   :func:`half_sum`, :func:`cos_d_of`, :func:`reflection_jacobian` — their first steps,
   shared with :mod:`~brdfkit.models.microfacet_anisotropic` and
   :mod:`~brdfkit.models.ashikhmin_shirley`.

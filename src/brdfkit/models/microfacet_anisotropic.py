@@ -37,7 +37,9 @@ Public objects
   and runs in the vectorised loop.
 - :func:`walter_anisotropic`, :func:`walter_sample_anisotropic`,
   :func:`walter_pdf_anisotropic` — its formulas (:mod:`brdfkit._dual`), traced by the
-  Mitsuba bridge.
+  Mitsuba bridge; :func:`walter_anisotropic_terms` (D G₁ G₁) and
+  :func:`walter_anisotropic_rgb` (three channels in the ``"rgb"`` loop, bit-equal per
+  channel to the per-channel kernel).
 
 References
 ----------
@@ -82,7 +84,7 @@ from brdfkit.models.microfacet_distributions import (
 from brdfkit.models.sampling import HalfVector, StrategySampled
 
 __all__ = ["MicrofacetAnisotropic", "walter_anisotropic", "walter_sample_anisotropic",
-           "walter_pdf_anisotropic"]
+           "walter_pdf_anisotropic", "walter_anisotropic_terms", "walter_anisotropic_rgb"]
 
 BECKMANN, GGX = 0, 1  # the packed value of the distribution choice
 
