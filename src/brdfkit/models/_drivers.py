@@ -81,6 +81,7 @@ import numba
 import numpy as np
 
 from brdfkit._cache import bounded_cache, memo
+from brdfkit._kern import load_input, store_output
 from brdfkit._threads import numba_threads  # noqa: F401  (re-exported)
 
 __all__ = ["SERIAL_BELOW", "UNIT_TOL", "VECTOR_OPTIONS", "LOOPS", "eval_pairs",
@@ -180,13 +181,16 @@ def _vector_chunk(a, b, o, p):  # pragma: no cover - compiled in the generated m
     # live after it), indices from 0 (a signed start needs the negative-index
     # wraparound select, and the loads are no longer an interleaved group),
     # a unit-stride store, and the count as int64(ok) (not a select of 0 and 1).
+    # The reads are load_input and the store store_output (brdfkit._kern): o is never an
+    # input, and so a kernel whose every read is a load_input (a compensated model's table)
+    # vectorises with gathers; for any other kernel the same run-time check as before.
     good = 0
     for j in range(o.shape[0]):
-        ix, iy, iz = a[3 * j], a[3 * j + 1], a[3 * j + 2]
-        ox, oy, oz = b[3 * j], b[3 * j + 1], b[3 * j + 2]
+        ix, iy, iz = load_input(a, 3 * j), load_input(a, 3 * j + 1), load_input(a, 3 * j + 2)
+        ox, oy, oz = load_input(b, 3 * j), load_input(b, 3 * j + 1), load_input(b, 3 * j + 2)
         ok = _unit_pair(ix, iy, iz, ox, oy, oz)
         v = kernel(ix, iy, iz, ox, oy, oz, p)  # noqa: F821 - total: safe for any input
-        o[j] = v if ok else math.nan
+        store_output(o, j, v if ok else math.nan)
         good += numba.int64(ok)
     return good
 
@@ -363,11 +367,13 @@ import math
 import numba
 import numpy as np
 
-from brdfkit.models._drivers import _CHUNK, VECTOR_OPTIONS, _compose, _unit_pair
+from brdfkit.models._drivers import (_CHUNK, VECTOR_OPTIONS, _compose, _unit_pair,
+                                     load_input, store_output)
 '''
 # the globals every generated loop reads, for the loops compiled in memory
 _LOOP_GLOBALS = {"math": math, "numba": numba, "np": np, "_unit_pair": _unit_pair,
-                 "_CHUNK": _CHUNK, "VECTOR_OPTIONS": VECTOR_OPTIONS}
+                 "_CHUNK": _CHUNK, "VECTOR_OPTIONS": VECTOR_OPTIONS,
+                 "load_input": load_input, "store_output": store_output}
 
 #: memo key -> (what it was built from, result): the entry holds what it was built from, so
 #: an id() in a key stays that object's while the entry lives; one entry per kernel, loop
