@@ -91,11 +91,13 @@ def kulla_conty_kernel(base_kernel, k: int, *, vector: bool = False):
     base kernel is branch-free and total (a formula of :mod:`brdfkit._dual`), so the
     composition runs in the vectorising loop."""
     loop, options = _options(vector)
-    return composed(_kulla_conty_vector if vector else _kulla_conty, loop=loop, options=options, base_kernel=base_kernel, k=int(k))
+    template = _kulla_conty_vector if vector else _kulla_conty
+    return composed(template, loop=loop, options=options, base_kernel=base_kernel, k=int(k))
 
 
 def turquin_kernel(base_kernel, k: int, *, vector: bool = False):
     """(kernel, driver) of f_base (1 + p[k] (1 − Ẽ(N·L))/Ẽ(N·L)) (cached); *vector* as
     :func:`kulla_conty_kernel`."""
     loop, options = _options(vector)
-    return composed(_turquin_vector if vector else _turquin, loop=loop, options=options, base_kernel=base_kernel, k=int(k))
+    template = _turquin_vector if vector else _turquin
+    return composed(template, loop=loop, options=options, base_kernel=base_kernel, k=int(k))
