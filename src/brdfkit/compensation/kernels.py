@@ -17,6 +17,11 @@ clamp what they read at 1 (:func:`_e`), so 1 − Ẽ ≥ 0 and the compensated a
 
 - :func:`kulla_conty_kernel` — f_base + c (1 − Ẽ(μ_i))(1 − Ẽ(μ_o));
 - :func:`turquin_kernel` — f_base (1 + F₀ (1 − Ẽ(μ_i))/Ẽ(μ_i)).
+
+A base whose eval is a formula is composed from the ``_vector`` templates, which LLVM
+vectorises with the table reads as gathers: every read a
+:func:`brdfkit._kern.load_input`, all of them before the base's code
+(``docs/architecture.md``, "Gathers in the vectorising loop").
 """
 
 from __future__ import annotations
