@@ -12,9 +12,13 @@ Prints, side by side in one run:
 2. evaluation time on N pairs (default 10 million, uniform on the hemisphere) of the
    base (GGX microfacet α = 0.3, modified-phong n = 20) and of its Kulla–Conty and
    Turquin compensations, the models timed in turn (base, KC, Turquin, base, …) and
-   the medians compared, and the median of the per-round ratios: target ≤ 1.3×.
+   the medians compared, and the median of the per-round ratios: target ≤ 1.3×;
+3. with ``--asm``: per evaluated model, what LLVM made of its compiled loop (counts in
+   Numba's ``inspect_asm`` of the loop body: ``vgather``, packed ``vmulpd`` against
+   scalar ``vmulsd``), the evidence of why a compensated kernel is slower
+   (``docs/compensation.md``, "Speed").
 
-Run: ``.venv/bin/python benchmarks/bench_compensation.py [--pairs N] [--repeats R]``.
+Run: ``.venv/bin/python benchmarks/bench_compensation.py [--pairs N] [--repeats R] [--asm]``.
 The machine should be otherwise idle (the kernels use every core).
 """
 
@@ -22,7 +26,9 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import statistics
+import subprocess
 
 import numpy as np
 from _timing import median_time
@@ -43,17 +49,48 @@ def _pairs(n, rng):
     return np.ascontiguousarray(wi), np.ascontiguousarray(wo)
 
 
+def _lscpu() -> str:
+    """lscpu's model name and the vector extensions among its flags."""
+    try:
+        out = subprocess.run(["lscpu"], capture_output=True, text=True, timeout=10).stdout
+    except (OSError, subprocess.SubprocessError):
+        return "unknown (lscpu failed)"
+    info = dict(line.split(":", 1) for line in out.splitlines() if ":" in line)
+    flags = [f for f in info.get("Flags", "").split() if f in ("avx", "avx2", "fma", "avx512f")]
+    return f"{info.get('Model name', '?').strip()} ({' '.join(flags)})"
+
+
+def _asm_counts(m) -> str:
+    """Counts of vector instructions in the compiled loop *m* evaluates with."""
+    import numba
+
+    from brdfkit.models._drivers import VECTOR_OPTIONS, loop_driver
+
+    driver = getattr(m, "_driver", None) or loop_driver(m.kernel)
+    chunk = driver.py_func.__globals__.get("chunk")  # the vector loop's inner body
+    if chunk is None:
+        return "not the vector loop"
+    # compiled again in memory: a loop loaded from Numba's disk cache has no assembly text
+    fresh = numba.njit(**VECTOR_OPTIONS)(chunk.py_func)
+    data = m._driver_data() if getattr(m, "_driver", None) is not None else m.packed
+    fresh(np.zeros(30), np.zeros(30), np.zeros(10), np.ascontiguousarray(data[0]))
+    asm = "\n".join(fresh.inspect_asm().values())
+    return ", ".join(f"{k} {len(re.findall(k, asm))}"
+                     for k in ("vgather", "vmulpd", "vmulsd", "zmm"))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--pairs", type=int, default=10_000_000)
     ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--asm", action="store_true", help="print the loops' vector instructions")
     args = ap.parse_args(argv)
     try:
         cpu = next(line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo")
                    if line.startswith("model name"))
     except (OSError, StopIteration):
         cpu = "unknown CPU"
-    print(f"# {cpu}; load average {os.getloadavg()[0]:.2f}")
+    print(f"# {cpu}; lscpu: {_lscpu()}; load average {os.getloadavg()[0]:.2f}")
     rng = np.random.default_rng(0)
 
     print(f"\n1. table build (engine tol {ENGINE_TOL:g}), median of {args.repeats}")
@@ -93,6 +130,9 @@ def main(argv=None):
             flag = "" if name == "base" else ("  OK" if max(ratio, paired) <= 1.3 else "  MISSED")
             print(f"   {label + ' ' + name:36s} {t * 1e3:10.1f} {args.pairs / t / 1e6:10.1f} "
                   f"{ratio:7.2f} {paired:5.2f}{flag}")
+        if args.asm:
+            for name, m in stages:
+                print(f"     asm of {name}'s loop: {_asm_counts(m)}")
     print(f"# load average after {os.getloadavg()[0]:.2f}")
 
 

@@ -30,11 +30,17 @@ ALLOWED_FUNCTIONS = set().union(*(functions for functions, _ in ALLOWED.values()
 
 
 def _reads(node: ast.AST, names: set[str]) -> bool:
-    """Whether *node* reads one of the arrays *names* at an index holding a variable."""
+    """Whether *node* reads one of the arrays *names* at an index holding a variable:
+    ``a[i]``, or ``load_input(a, i)`` (brdfkit._kern's tagged read, the vector loop's)."""
     for sub in ast.walk(node):
         if (isinstance(sub, ast.Subscript) and isinstance(sub.ctx, ast.Load)
                 and isinstance(sub.value, ast.Name) and sub.value.id in names
                 and any(isinstance(n, ast.Name) for n in ast.walk(sub.slice))):
+            return True
+        if (isinstance(sub, ast.Call) and isinstance(sub.func, ast.Name)
+                and sub.func.id == "load_input" and len(sub.args) == 2
+                and isinstance(sub.args[0], ast.Name) and sub.args[0].id in names
+                and any(isinstance(n, ast.Name) for n in ast.walk(sub.args[1]))):
             return True
     return False
 

@@ -18,6 +18,17 @@ depends on a lane's data unless that address is in bounds for *any* input
 (NaN and inf included: the driver computes every lane and selects).
 :func:`exp_nonpos` is ``exp`` for x ≤ 0 written that way (< 1 ulp measured
 against ``math.exp``); :func:`bits_to_float` builds 2^k from its bits.
+
+A load at a data-dependent index (a table a kernel reads, e.g. a compensation's Ẽ(μ)) is
+vectorised with gathers only when LLVM knows the loop's store does not overlap it: Numba
+gives array arguments no ``noalias``, and LLVM cannot build the run-time overlap check for
+a non-affine index ("loop not vectorized: cannot identify array bounds";
+``benchmarks/probe_vectorise_lookup.py``). :func:`load_input` (every read of the "vector"
+loop's inputs: directions, packed rows, tables) and :func:`store_output` (its one store)
+say so with LLVM's scoped-noalias metadata. Alias sets merge transitively, so *every* load
+in such a loop must be a :func:`load_input` (:func:`load_inputs` reads a kernel's
+parameters as a tuple) for a gather to vectorise; an ordinary load only costs the
+run-time check, as before.
 """
 
 from __future__ import annotations
@@ -26,7 +37,7 @@ import math
 
 import numba
 from llvmlite import ir
-from numba.core import types
+from numba.core import cgutils, types
 from numba.extending import intrinsic
 
 INV_PI = 1.0 / math.pi
@@ -124,6 +135,96 @@ def pos_pow(x: float, n: float) -> float:
     if x <= 0.0:
         return 1.0 if n == 0.0 else 0.0
     return x**n
+
+
+# --------------------------------------------------------------------------- no-alias accesses
+def _input_scope(module):
+    """The metadata list of the one scope "inputs of a pair loop" (uniqued by content, so
+    the same node in every module Numba links)."""
+    domain = module.add_metadata(["brdfkit pair loop"])
+    return module.add_metadata([module.add_metadata(["brdfkit pair loop inputs", domain])])
+
+
+def _element_pointer(context, builder, arr_type, arr, index):
+    """Address of element *index* (an intp) of the 1-D array *arr* (its stride honoured)."""
+    ary = context.make_array(arr_type)(context, builder, arr)
+    return cgutils.get_item_pointer(context, builder, arr_type, ary, [index], wraparound=False)
+
+
+@intrinsic
+def load_input(typingctx, arr, index):
+    """``arr[index]`` of a 1-D array, tagged as an input of the pair loop
+    (``!alias.scope``): no wraparound of negative indices and no bounds check — callers
+    pass an index in bounds (0 ≤ index < len), as the kernels' totality requires."""
+    if not (isinstance(arr, types.Array) and arr.ndim == 1 and isinstance(index, types.Integer)):
+        return None
+    sig = arr.dtype(arr, types.intp)
+
+    def codegen(context, builder, signature, args):
+        value = builder.load(_element_pointer(context, builder, signature.args[0], *args))
+        value.set_metadata("alias.scope", _input_scope(builder.module))
+        return value
+
+    return sig, codegen
+
+
+@intrinsic
+def store_output(typingctx, arr, index, value):
+    """``arr[index] = value`` declared not to alias any :func:`load_input` (``!noalias``):
+    the loop's output is never one of its inputs (``BRDF.eval`` allocates it)."""
+    if not (isinstance(arr, types.Array) and arr.ndim == 1 and isinstance(index, types.Integer)):
+        return None
+    sig = types.void(arr, types.intp, arr.dtype)
+
+    def codegen(context, builder, signature, args):
+        ptr = _element_pointer(context, builder, signature.args[0], args[0], args[1])
+        store = builder.store(args[2], ptr)
+        store.set_metadata("noalias", _input_scope(builder.module))
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+@intrinsic
+def load_inputs(typingctx, arr, n):
+    """``(arr[0], …, arr[n − 1])`` as a tuple, each a :func:`load_input`; *n* a compile-time
+    constant (a base kernel's parameter count), so that a kernel reading its parameters
+    ``p[CONST]`` reads them from the tuple instead of memory."""
+    if not (isinstance(arr, types.Array) and arr.ndim == 1
+            and isinstance(n, types.IntegerLiteral)):
+        return None
+    count = n.literal_value
+    tup = types.UniTuple(arr.dtype, count)
+
+    def codegen(context, builder, signature, args):
+        scope = _input_scope(builder.module)
+        out = context.get_constant_undef(tup)
+        for i in range(count):
+            ptr = _element_pointer(context, builder, signature.args[0], args[0],
+                                   context.get_constant(types.intp, i))
+            value = builder.load(ptr)
+            value.set_metadata("alias.scope", scope)
+            out = builder.insert_value(out, value, i)
+        return out
+
+    return tup(arr, n), codegen
+
+
+@intrinsic
+def clamp_unit(typingctx, x):
+    """*x* clamped to [0, 1], NaN to 0: two LLVM selects in one basic block. The
+    if-statement clamps of a lookup compiled to branches (merged by jump threading into a
+    three-way phi that stays a branch), which kept its loop from vectorising."""
+    if not isinstance(x, types.Float):
+        return None
+    sig = types.float64(types.float64)
+
+    def codegen(context, builder, signature, args):
+        zero, one = ir.Constant(ir.DoubleType(), 0.0), ir.Constant(ir.DoubleType(), 1.0)
+        low = builder.select(builder.fcmp_ordered(">=", args[0], zero), args[0], zero)
+        return builder.select(builder.fcmp_ordered("<", low, one), low, one)
+
+    return sig, codegen
 
 
 # --------------------------------------------------------------------------- vectorisable exp

@@ -20,7 +20,8 @@ model's divisor) needs, defined once:
    cubics on a two-level grid whose nodes include the function's kinks, with a
    verified margin so that it bounds the function from a chosen side.
 
-This is a low layer: it imports NumPy, Numba and :mod:`brdfkit.errors` only
+This is a low layer: it imports NumPy, Numba, :mod:`brdfkit.errors` and
+:mod:`brdfkit._kern` only
 (models and engines import it, never the reverse).
 
 Public objects
@@ -40,6 +41,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from brdfkit._kern import clamp_unit, load_input
 from brdfkit.errors import BrdfkitError, ParameterError
 
 __all__ = [
@@ -109,25 +111,28 @@ def _lookup(p, off, mu):  # pragma: no cover - compiled
     """Value at μ = *mu* of the piecewise-cubic :class:`Lookup` stored at ``p[off:]``.
 
     Two levels, no square root, no search: the cell is ``int(μ·M)``; inside it a
-    uniform grid anchored at the cell's kink (see :class:`Lookup`).
+    uniform grid anchored at the cell's kink (see :class:`Lookup`). Branch-free (the
+    clamps compile to selects) and every read a :func:`brdfkit._kern.load_input`, so
+    that in the vectorising loop it compiles to gathers (a compensated model's kernel).
     """
-    if not mu >= 0.0:
-        mu = 0.0  # only reached with mu > 0 from the kernels; keeps the index >= 0 regardless
-    if mu > 1.0:
-        mu = 1.0  # |ω| = 1 up to rounding (or an unnormalised input): keep the index in range
-    m = int(p[off])
-    j = int(mu * m)
+    # clamp to [0, 1] (NaN to 0), no branch: only reached with 0 < mu <= 1 from the kernels up
+    # to rounding (|ω| = 1), it keeps every index in range for any input
+    mu = clamp_unit(mu)
+    m = numba.int64(load_input(p, off))  # casts: int() is a call to an overload,
+    # which the loop vectoriser meets before it is inlined
+    j = numba.int64(mu * m)
     if j > m - 1:
         j = m - 1  # mu = 1: the last cell
     h = off + 1 + 4 * j
-    y = (mu - p[h]) * p[h + 1]  # grid coordinate from the cell's anchor (>= 0 by construction)
-    k = int(y)
-    last = int(p[h + 3])
+    y = (mu - load_input(p, h)) * load_input(p, h + 1)  # from the cell's anchor (>= 0)
+    k = numba.int64(y)
+    last = numba.int64(load_input(p, h + 3))
     if k > last:
         k = last  # the cell's last node (mu at the cell's upper edge)
     t = y - k
-    b = off + int(p[h + 2]) + 4 * k
-    return ((p[b] * t + p[b + 1]) * t + p[b + 2]) * t + p[b + 3]
+    b = off + numba.int64(load_input(p, h + 2)) + 4 * k
+    return (((load_input(p, b) * t + load_input(p, b + 1)) * t + load_input(p, b + 2)) * t
+            + load_input(p, b + 3))
 
 
 @dataclass(frozen=True)

@@ -17,12 +17,18 @@ clamp what they read at 1 (:func:`_e`), so 1 − Ẽ ≥ 0 and the compensated a
 
 - :func:`kulla_conty_kernel` — f_base + c (1 − Ẽ(μ_i))(1 − Ẽ(μ_o));
 - :func:`turquin_kernel` — f_base (1 + F₀ (1 − Ẽ(μ_i))/Ẽ(μ_i)).
+
+A base whose eval is a formula is composed from the ``_vector`` templates, which LLVM
+vectorises with the table reads as gathers: every read a
+:func:`brdfkit._kern.load_input`, all of them before the base's code
+(``docs/architecture.md``, "Gathers in the vectorising loop").
 """
 
 from __future__ import annotations
 
 import numba
 
+from brdfkit._kern import load_input, load_inputs
 from brdfkit.models._drivers import VECTOR_OPTIONS, composed
 from brdfkit.tables import _lookup
 
@@ -56,6 +62,31 @@ def _turquin(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
     return f * (1.0 + p[k] * (1.0 - e_i) / e_i)
 
 
+# The same for the vectorising loop ("vector", a base whose eval is a formula). Two things
+# make LLVM vectorise it, with the table reads as gathers (each measured: without either the
+# loop stays scalar; benchmarks/probe_vectorise_lookup.py, docs/compensation.md "Speed"):
+# every read is a load_input (brdfkit._kern), the base's parameters passed to it as a tuple
+# (load_inputs: a formula reads p[CONST], from a tuple as from an array), so that LLVM knows
+# no read aliases the loop's store; and every read comes before the base's code (a read
+# after it made the loop "not vectorized: call instruction cannot be vectorized").
+def _kulla_conty_vector(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
+    q = load_inputs(p, k)
+    c = load_input(p, k)
+    e_i = _e(p, k + 1, iz)
+    e_o = _e(p, k + 1, oz)
+    f = base_kernel(ix, iy, iz, ox, oy, oz, q)  # 0 below the horizon
+    ms = c * (1.0 - e_i) * (1.0 - e_o)
+    return f + (ms if (iz > 0.0) & (oz > 0.0) else 0.0)
+
+
+def _turquin_vector(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
+    q = load_inputs(p, k)
+    f0 = load_input(p, k)
+    e_i = _e(p, k + 1, iz)  # >= E_FLOOR > 0 (brdfkit.compensation.table): no 0/0
+    f = base_kernel(ix, iy, iz, ox, oy, oz, q)  # 0 below the horizon
+    return f * (1.0 + f0 * (1.0 - e_i) / e_i)
+
+
 def _options(vector: bool) -> tuple[str, dict]:
     return ("vector", {"inline": "always", **VECTOR_OPTIONS}) if vector else ("checked", None)
 
@@ -65,11 +96,13 @@ def kulla_conty_kernel(base_kernel, k: int, *, vector: bool = False):
     base kernel is branch-free and total (a formula of :mod:`brdfkit._dual`), so the
     composition runs in the vectorising loop."""
     loop, options = _options(vector)
-    return composed(_kulla_conty, loop=loop, options=options, base_kernel=base_kernel, k=int(k))
+    template = _kulla_conty_vector if vector else _kulla_conty
+    return composed(template, loop=loop, options=options, base_kernel=base_kernel, k=int(k))
 
 
 def turquin_kernel(base_kernel, k: int, *, vector: bool = False):
     """(kernel, driver) of f_base (1 + p[k] (1 − Ẽ(N·L))/Ẽ(N·L)) (cached); *vector* as
     :func:`kulla_conty_kernel`."""
     loop, options = _options(vector)
-    return composed(_turquin, loop=loop, options=options, base_kernel=base_kernel, k=int(k))
+    template = _turquin_vector if vector else _turquin
+    return composed(template, loop=loop, options=options, base_kernel=base_kernel, k=int(k))

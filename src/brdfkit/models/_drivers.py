@@ -83,6 +83,7 @@ import numpy as np
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from brdfkit._cache import bounded_cache, memo
+from brdfkit._kern import load_input, store_output
 from brdfkit._threads import numba_threads  # noqa: F401  (re-exported)
 
 __all__ = ["SERIAL_BELOW", "UNIT_TOL", "VECTOR_OPTIONS", "LOOPS", "eval_pairs",
@@ -177,23 +178,23 @@ def eval_pairs_checked(kernel, wi, wo, P, out):  # pragma: no cover - compiled
 # `kernel` and `chunk` are the globals of each generated module. "rgb": the same with RGB =
 # True, kernel(…, t) -> (f0, f1, f2) over the rows as one tuple: shared work done once.
 def _vector_chunk(a, b, o, p):  # pragma: no cover - compiled in the generated modules
-    # The pairs in a and b (flat, 3 per pair) into o; returns the number of good pairs.
-    # LLVM vectorises it given (each measured): its own function (in a prange body Numba keeps
-    # the loop's variables live), indices from 0 (no wraparound select; the loads stay an
-    # interleaved group), unit-stride stores, the count as int64(ok), no loads of p (RGB).
+    # Pairs of a and b (flat, 3 per pair) into o; returns the good pairs' count. LLVM vectorises
+    # it given (each measured): its own function (in a prange body Numba keeps the loop's
+    # variables live), indices from 0 (no wraparound select: the loads an interleaved group),
+    # unit-stride stores, int64(ok) counts, no p loads (RGB), load_input/store_output (_kern).
     good = 0
     for j in range(o.shape[0] // (3 if RGB else 1)):  # noqa: F821
-        ix, iy, iz = a[3 * j], a[3 * j + 1], a[3 * j + 2]
-        ox, oy, oz = b[3 * j], b[3 * j + 1], b[3 * j + 2]
+        ix, iy, iz = load_input(a, 3 * j), load_input(a, 3 * j + 1), load_input(a, 3 * j + 2)
+        ox, oy, oz = load_input(b, 3 * j), load_input(b, 3 * j + 1), load_input(b, 3 * j + 2)
         ok = _unit_pair(ix, iy, iz, ox, oy, oz)
         if RGB:  # noqa: F821 - a constant: Numba prunes the branch not taken; o: (m, 3) flat
             v0, v1, v2 = kernel(ix, iy, iz, ox, oy, oz, p)  # noqa: F821 - total
-            o[3 * j] = v0 if ok else math.nan  # an interleaved store group
-            o[3 * j + 1] = v1 if ok else math.nan
-            o[3 * j + 2] = v2 if ok else math.nan
+            store_output(o, 3 * j, v0 if ok else math.nan)  # an interleaved store group
+            store_output(o, 3 * j + 1, v1 if ok else math.nan)
+            store_output(o, 3 * j + 2, v2 if ok else math.nan)
         else:
             v = kernel(ix, iy, iz, ox, oy, oz, p)  # noqa: F821 - total: safe for any input
-            o[j] = v if ok else math.nan
+            store_output(o, j, v if ok else math.nan)
         good += numba.int64(ok)
     return good
 
@@ -381,11 +382,12 @@ import numba
 import numpy as np
 
 from brdfkit.models._drivers import (_CHUNK, VECTOR_OPTIONS, _compose, _unit_pair,
-                                     to_fixed_tuple)
+                                     load_input, store_output, to_fixed_tuple)
 '''
 # the globals every generated loop reads, for the loops compiled in memory
 _LOOP_GLOBALS = {"math": math, "numba": numba, "np": np, "_unit_pair": _unit_pair, "_CHUNK": _CHUNK,
-                 "VECTOR_OPTIONS": VECTOR_OPTIONS, "to_fixed_tuple": to_fixed_tuple}
+                 "VECTOR_OPTIONS": VECTOR_OPTIONS, "to_fixed_tuple": to_fixed_tuple,
+                 "load_input": load_input, "store_output": store_output}
 
 #: memo key -> (what it was built from, result): the entry holds what it was built from, so
 #: an id() in a key stays that object's while the entry lives; one entry per kernel, loop
