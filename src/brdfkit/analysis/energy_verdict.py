@@ -26,8 +26,8 @@ estimates the albedo engine's (:func:`~brdfkit.analysis.albedo`), E_avg is
   model the deficit is of the albedo averaged over φ_i (the 24 azimuths), and its range
   over φ_i is recorded. Each with the engine's error estimate.
 - **E_avg** = 2 ∫₀¹ a(μ) μ dμ (ρ_hh, Kulla–Conty's E_avg), with its error estimate.
-- **Maximum deficit** (:func:`max_deficit`, the figure's energy axis) — the largest
-  1 − a(θ_i) over θ_i ≤ 89° on check's grid (0, 3, …, 87, 89°).
+- **Furnace deviation** (:func:`furnace_deviation`, the figure's energy axis) — the
+  1 − a(θ_i) of largest magnitude over θ_i ≤ 89° on check's grid (0, 3, …, 87, 89°).
 
 A number is never stated beyond its accuracy: :func:`bound_text` prints a value whose
 magnitude is within its error as "0 (±err)", and the verdict's ``status`` is check's
@@ -38,8 +38,8 @@ Public objects
 - :class:`EnergyVerdict` — the result (``to_dict``: the JSON row of ``brdfkit verdicts``).
 - :func:`energy_verdict` — compute it for one model.
 - :func:`furnace` — a(θ_i), 1 − a(θ_i) and the error estimate at given angles.
-- :func:`max_deficit` — the largest white-furnace deficit over θ_i ≤ 89°.
-- :func:`energy_reciprocity` — the figure's point: (max deficit, its error, asymmetry).
+- :func:`furnace_deviation` — the largest white-furnace |1 − a| over θ_i ≤ 89°, signed.
+- :func:`energy_reciprocity` — the figure's point: furnace deviation and asymmetry.
 - :func:`bound_text` — a value with its accuracy, never more digits than it supports.
 - :data:`FURNACE_DEG`, :data:`ANISO_PHI_DEG`.
 
@@ -65,7 +65,7 @@ from brdfkit.models._base import BRDF
 from brdfkit.status import STATUS
 
 __all__ = ["ANISO_PHI_DEG", "FURNACE_DEG", "EnergyVerdict", "bound_text", "energy_reciprocity",
-           "energy_verdict", "furnace", "max_deficit"]
+           "energy_verdict", "furnace", "furnace_deviation"]
 
 #: The white furnace angles of the table (degrees).
 FURNACE_DEG = (0.0, 60.0, 80.0, 89.0)
@@ -132,23 +132,28 @@ def furnace(model, theta_deg=FURNACE_DEG, *, tol: float = 1e-7) -> dict:
     return out
 
 
-def max_deficit(model, *, tol: float = 1e-7) -> tuple[float, float, float]:
-    """(largest 1 − a(θ_i) over θ_i ≤ 89° on check's grid, its θ_i in degrees, the engine's
-    error estimate there). An anisotropic model's a is averaged over φ_i first
-    (:func:`furnace`). Negative when the model reflects more than it receives everywhere."""
+def furnace_deviation(model, *, tol: float = 1e-7) -> dict:
+    """The figure's energy measure: the white-furnace deviation of largest magnitude over
+    θ_i ≤ 89° on check's grid (0, 3, …, 87, 89°).
+
+    Returns ``{"deviation", "theta_deg", "error"}``: 1 − a(θ_i) there (signed: positive a
+    loss, negative a gain), its θ_i and the engine's error estimate. An anisotropic
+    model's a is averaged over φ_i first (:func:`furnace`).
+    """
+    _check_model(model, "furnace_deviation")
     grid = [g for g in ENERGY_GRID_DEG if g <= 89.0]
     f = furnace(model, grid, tol=tol)
-    k = int(np.argmax(f["deficit"]))
-    return float(f["deficit"][k]), float(grid[k]), float(f["error"][k])
+    k = int(np.argmax(np.abs(f["deficit"])))
+    return {"deviation": float(f["deficit"][k]), "theta_deg": float(grid[k]),
+            "error": float(f["error"][k])}
 
 
 def energy_reciprocity(model, *, tol: float = 1e-7) -> dict:
-    """One point of the "energy against reciprocity" figure: ``{"deficit", "theta_deg",
-    "error"}`` of :func:`max_deficit` and ``"asymmetry"``, check's reciprocity measure
+    """One point of the "energy against reciprocity" figure: :func:`furnace_deviation`'s
+    dict plus ``"asymmetry"``, check's reciprocity measure
     (:func:`~brdfkit.analysis.plausibility.reciprocity`, exact up to rounding)."""
     _check_model(model, "energy_reciprocity")
-    d, th, err = max_deficit(model, tol=tol)
-    return {"deficit": d, "theta_deg": th, "error": err, "asymmetry": reciprocity(model)}
+    return {**furnace_deviation(model, tol=tol), "asymmetry": reciprocity(model)}
 
 
 @dataclass
