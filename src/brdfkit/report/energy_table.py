@@ -260,7 +260,8 @@ def timed_energy_table(**kwargs) -> tuple[list[dict], float]:
 
 # --------------------------------------------------------------------------- formatting
 def _num(v: float, err: float) -> str:
-    """*v* to the digits its error supports: "0" when |v| ≤ err, at most 4 decimals."""
+    """*v* to the digits its error supports: "0" when |v| ≤ err; else up to the decimal
+    where the error is (that last digit uncertain), at most 4 decimals."""
     if not math.isfinite(v):
         return f"{v}"
     if math.isfinite(err) and abs(v) <= err:
@@ -268,7 +269,7 @@ def _num(v: float, err: float) -> str:
     if abs(v) < 1e-3:
         return f"{v:.2g}"
     decimals = 4 if not math.isfinite(err) or err <= 5e-5 else \
-        max(0, min(4, -math.floor(math.log10(2 * err))))
+        max(0, min(4, -math.floor(math.log10(err))))
     return f"{v:.{decimals}f}"
 
 
