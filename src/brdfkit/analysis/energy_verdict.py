@@ -248,8 +248,11 @@ def energy_verdict(model, *, label: str | None = None, tol: float = 1e-7) -> Ene
     h = hemispherical_albedo(model, tol=tol)
     # the engine's error estimate at the maximum: one more albedo there (check records the
     # largest estimate over its grid)
-    rm = albedo(model, math.radians(min(v.theta_max_deg, 89.999)), phi=phi, tol=tol)
-    err_max = float(np.max(np.asarray(rm.error)))
+    if math.isfinite(v.theta_max_deg):
+        rm = albedo(model, math.radians(min(v.theta_max_deg, 89.999)), phi=phi, tol=tol)
+        err_max = float(np.max(np.asarray(rm.error)))
+    else:  # no maximum (a NaN albedo: check's verdict is nonfinite)
+        err_max = math.inf
     notes = list(v.notes)
     if not h.success:
         notes.append(f"E_avg: {h.message}")
