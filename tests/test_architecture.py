@@ -27,6 +27,9 @@ LAYER = {
     # so the data layer and the operators (pumping) are beside it and cli/figures above
     "": 2, "spec": 2, "models": 1,
     "analysis": 2, "data": 2, "pumping": 2,
+    # compensation: the second operator beside pumping (issue 22), reusing pumping's albedo
+    # table builder; spec_operators: the spec's operator registry (moved out of spec)
+    "compensation": 2, "spec_operators": 2,
     # user: models from the user's own files (.py, .brdf), built on models/ and data/
     # (the tabulated sampler); formula: what a user's .py file imports (layer 1: _dual and
     # Param); spec_words: the spec's NAME=VALUE parsing
@@ -39,7 +42,7 @@ MAX_LINES = 600
 HOOKS = {"isotropic", "specular_albedo", "albedo_kinks", "albedo_kinks_nv", "albedo_kink_mus",
          "has_delta", "has_sampler", "lobes", "sharpest_lobe", "kernel", "packed", "n_channels",
          "reciprocal", "sample", "pdf", "to_dict", "formulas", "fit_gauge", "fit_base",
-         "fit_bound_starts"}
+         "fit_bound_starts", "fresnel_split"}
 
 
 def _modules():

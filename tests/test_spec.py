@@ -164,6 +164,35 @@ def test_stages_with_different_g_round_trip():
     np.testing.assert_array_equal(spec.build().eval(wi, wo), m.eval(wi, wo))
 
 
+def test_compensated_model_round_trip():
+    """compensate (issue 22): the dict form, the flat form, of(m).build(), and the order of
+    operators kept (compensate, then pump: the dict's keys in the order applied)."""
+    spec = ModelSpec.parse("microfacet", ["distribution=ggx", "alpha=0.5"],
+                           compensate="kulla-conty", pump="max")
+    assert spec.operators == (Operator("compensate", (("method", "kulla-conty"),)),
+                              Operator("pump", (("g", "max"), ("times", 1))))
+    m = spec.build()
+    d = m.to_dict()
+    assert list(d) == ["model", "params", "compensate", "pump"]
+    assert d["compensate"] == {"method": "kulla-conty"}
+    by_hand = pump(brdfkit.compensate(brdfkit.model("microfacet", distribution="ggx",
+                                                    alpha=0.5)), "max")
+    wi, wo = _pairs(30)
+    want = by_hand.eval(wi, wo)
+    np.testing.assert_array_equal(m.eval(wi, wo), want)
+    np.testing.assert_array_equal(ModelSpec.of(m).build().eval(wi, wo), want)
+    t = brdfkit.compensate(brdfkit.model("modified-phong", n=20), "turquin")
+    flat = ModelSpec.from_dict({"model": "modified-phong", "params": t.to_dict()["params"],
+                                "compensate": "turquin"})
+    assert flat == ModelSpec.of(t)
+    np.testing.assert_array_equal(flat.build().eval(wi, wo), t.eval(wi, wo))
+    assert ModelSpec.from_dict({"model": "lambert", "compensate": None}).operators == ()
+    with pytest.raises(BrdfkitError, match="--compensate must be one of kulla-conty, turquin"):
+        ModelSpec.parse("lambert", compensate="kc2")
+    with pytest.raises(ParameterError, match="compensate: unknown argument 'g'; valid: method"):
+        ModelSpec.from_dict({"model": "lambert", "compensate": {"g": "max"}})
+
+
 def test_pumped_material_rebuilds_from_its_dict():
     """The bug of issue 18: pumping.from_dict resolved names in the model registry only, so
     a pumped material (whose to_dict names merl:…) could not be rebuilt."""
@@ -207,7 +236,7 @@ def test_merl_file_spec(tmp_path):
 
 def test_tables_name_every_kind_and_operator():
     assert [k.name for k in KINDS] == ["python-file", "brdf-file", "material", "merl-file", "model"]
-    assert list(OPERATORS) == ["pump"]
+    assert list(OPERATORS) == ["pump", "compensate"]
     assert ModelSpec("nickel").kind == "model"  # the fallback claims the rest (then fails)
 
 

@@ -40,6 +40,8 @@ Public objects
   material by its spec (``merl:nickel``, ``rgl:NAME``, ``nielsen:NAME``, a
   ``.binary`` path): the one dispatcher (:mod:`brdfkit.spec`).
 - :func:`brdfkit.model_params` — the parameter declarations a spec accepts.
+- :func:`brdfkit.compensate` — energy compensation of a model (Kulla–Conty,
+  Turquin; :mod:`brdfkit.compensation`, ``docs/compensation.md``).
 - :class:`brdfkit.ModelSpec` — what to build, its parameters and the operators
   applied to it, from the command line's words or a dict (:mod:`brdfkit.spec`).
 - :func:`brdfkit.material` / :func:`brdfkit.materials` — the built-in
@@ -78,6 +80,7 @@ __all__ = [
     "UnknownModelError",
     "cache_info",
     "clear_caches",
+    "compensate",
     "material",
     "materials",
     "model",
@@ -86,3 +89,12 @@ __all__ = [
 ]
 
 __version__ = "0.1.0"
+
+
+def compensate(model, method: str = "kulla-conty"):
+    """:func:`brdfkit.compensation.compensate`: *model* with its lost energy restored by
+    *method* (``"kulla-conty"`` or ``"turquin"``). Imported on first use, like pumping
+    (``import brdfkit`` does not pay for the albedo engine)."""
+    from brdfkit.compensation import compensate as _compensate
+
+    return _compensate(model, method)

@@ -19,6 +19,8 @@ Public objects
   index η + iκ (conductors); equals :func:`fresnel_dielectric` at κ = 0.
 - :func:`fresnel_schlick` — Schlick's approximation F₀ + (1 − F₀)(1 − c)⁵.
 - :func:`f0_from_eta` — normal-incidence reflectance ((η − 1)/(η + 1))².
+- :func:`fresnel_moments` — F(1) and the cosine-weighted average 2∫₀¹ F(μ) μ dμ of the
+  conductor reflectance (Kulla & Conty 2017's F_avg), per channel.
 
 References
 ----------
@@ -41,7 +43,8 @@ import numpy as np
 from brdfkit._cache import memo
 from brdfkit._dual import absolute, formula, maximum, minimum, select, sqrt
 
-__all__ = ["fresnel_dielectric", "fresnel_conductor", "fresnel_schlick", "f0_from_eta"]
+__all__ = ["fresnel_dielectric", "fresnel_conductor", "fresnel_schlick", "f0_from_eta",
+           "fresnel_moments"]
 
 
 def _fresnel_dielectric_py(c: float, eta: float) -> float:
@@ -189,3 +192,47 @@ def f0_from_eta(eta):
     """Normal-incidence reflectance ((η − 1)/(η + 1))² of a dielectric."""
     eta = _check_positive("eta", eta)
     return ((eta - 1.0) / (eta + 1.0)) ** 2
+
+
+#: Gauss–Legendre nodes per panel of :func:`fresnel_moments`: on each panel F is analytic
+#: in t (below), so 64 nodes reach rounding (tests/test_compensation.py checks 1e-13
+#: against scipy.integrate.quad).
+_MOMENT_NODES = 64
+
+
+def fresnel_moments(eta, k=0.0) -> tuple[np.ndarray, np.ndarray]:
+    """F₀ = F(1) and F_avg = 2∫₀¹ F(μ) μ dμ of :func:`fresnel_conductor`, per channel.
+
+    F_avg is the cosine-weighted hemispherical average of Kulla & Conty 2017 (slide
+    "Multiple scattering: Fresnel", their F_avg). For η < 1 (κ = 0) F = 1 below the
+    critical cosine μ_c = √(1 − η²) and has a square-root edge there: the rule splits
+    [0, 1] at μ_c and substitutes μ = μ_c + (1 − μ_c) t² on the upper panel, which makes
+    the integrand smooth (also for small κ > 0, where the edge is rounded).
+
+    Parameters
+    ----------
+    eta, k : array_like (C,) or scalar
+        The complex index η + iκ (η > 0, κ ≥ 0), broadcast against each other.
+
+    Returns
+    -------
+    (f0, f_avg) : two 1-D arrays of the broadcast shape (at least one element).
+    """
+    eta = np.atleast_1d(_check_positive("eta", eta))
+    k = np.atleast_1d(np.asarray(k, dtype=np.float64))
+    if np.any(~(k >= 0.0)):
+        raise ValueError(f"k (extinction coefficient) must be >= 0; got {k!r}")
+    eta, k = np.broadcast_arrays(eta, k)
+    x, w = np.polynomial.legendre.leggauss(_MOMENT_NODES)
+    t, wt = 0.5 * (x + 1.0), 0.5 * w  # on [0, 1]
+    conductor = _ufunc("conductor")
+    f0 = conductor(1.0, eta, k)
+    f_avg = np.empty_like(f0)
+    for j, (e, kk) in enumerate(zip(eta.ravel(), k.ravel(), strict=True)):
+        mu_c = math.sqrt(max(1.0 - e * e, 0.0))  # 0 for η ≥ 1: one panel
+        mu = mu_c * t  # the lower panel [0, μ_c] (empty for η ≥ 1)
+        lower = float(np.sum(wt * 2.0 * mu * conductor(mu, e, kk))) * mu_c
+        mu = mu_c + (1.0 - mu_c) * t * t  # dμ = 2(1 − μ_c) t dt
+        upper = float(np.sum(wt * 2.0 * mu * conductor(mu, e, kk) * 2.0 * (1.0 - mu_c) * t))
+        f_avg.ravel()[j] = lower + upper
+    return f0.ravel(), f_avg.ravel()

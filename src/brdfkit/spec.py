@@ -27,9 +27,11 @@ built-in measured material ``merl:NAME[@nbrdf|npf|abc|sgd]``, ``rgl:NAME``,
 ``PATH.binary`` (:class:`~brdfkit.data.MeasuredBRDF`, parameter ``lookup``); else a
 registered model name or alias (:data:`brdfkit.MODELS`).
 
-Operators (:data:`OPERATORS`, applied in the order given): ``pump`` with ``g``
-(``max``, ``controlled``) and ``times`` (1 … :data:`MAX_TIMES`), that is
-:func:`brdfkit.pumping.pump` (Neumann et al. 1999, eqs. 16–21).
+Operators (:data:`OPERATORS`, :mod:`brdfkit.spec_operators`; applied in the order
+given): ``pump`` with ``g`` (``max``, ``controlled``) and ``times`` (1 …
+:data:`MAX_TIMES`), that is :func:`brdfkit.pumping.pump` (Neumann et al. 1999, eqs.
+16–21); ``compensate`` with ``method`` (``kulla-conty``, ``turquin``), that is
+:func:`brdfkit.compensation.compensate`.
 
 A half-angle ``beta`` among the parameters (degrees on the command line,
 radians in a dict) is resolved once, when the spec is made, into the model's
@@ -73,6 +75,14 @@ from brdfkit.data.catalog import (
 )
 from brdfkit.errors import BrdfkitError, ParameterError, UnknownModelError
 from brdfkit.models import BRDF, resolve
+from brdfkit.spec_operators import (
+    OPERATORS,
+    TIMES_REASON,
+    OperatorKind,
+    _compensation,
+    _pumping,
+    times_problem,
+)
 from brdfkit.spec_words import parse_words, property_value
 
 __all__ = ["ModelSpec", "Operator", "model", "model_params", "canonical_name", "parse_items",
@@ -83,22 +93,10 @@ __all__ = ["ModelSpec", "Operator", "model", "model_params", "canonical_name", "
 #: How a material spec is written (for error messages and help texts).
 SPEC_FORMS = ("merl:NAME[@nbrdf|@npf|@abc|@sgd], rgl:NAME, nielsen:NAME or a path to a "
               "MERL .binary file ('brdfkit materials' lists the built-in ones)")
-# brdfkit.pumping is imported on first use, not with the package (`import brdfkit`, every
-# command's start, does not pay ~7 ms for it); so are PUMP_CHOICES (its G_CHOICES) and MAX_TIMES.
-def _pumping():
-    import brdfkit.pumping
-    return brdfkit.pumping
-
-
 def __getattr__(name: str):
     if name in ("PUMP_CHOICES", "MAX_TIMES"):
         return tuple(_pumping().G_CHOICES) if name == "PUMP_CHOICES" else _pumping().MAX_TIMES
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-#: Why the number of pumpings is bounded (:data:`MAX_TIMES`), for messages and help.
-TIMES_REASON = ("each pumping tabulates the previous stage's albedo, so the cost grows with "
-                "the number of stages: times=8 takes about a minute")
 
 
 # --------------------------------------------------------------------------- what to build
@@ -273,75 +271,6 @@ def parse_items(name, items: Iterable[str] | Mapping, *, option: str = "-p") -> 
     return parse_words(template.name, template.params, items, option=option)
 
 
-def times_problem(times) -> str | None:
-    """Why *times* is not a valid number of pumpings (without the option name), or None."""
-    try:
-        top = _pumping().MAX_TIMES
-        ok = not isinstance(times, bool) and int(times) == times and 1 <= times <= top
-    except (TypeError, ValueError):  # not a number at all (e.g. a string through the API)
-        ok = False
-    if not ok:
-        return (f"must be an integer from 1 to {_pumping().MAX_TIMES}; got {times} "
-                f"({TIMES_REASON})")
-    return None
-
-
-# --------------------------------------------------------------------------- operators
-@dataclass(frozen=True)
-class OperatorKind:
-    """One operator a spec can apply: ``key``, its name and dict key; ``stages(value, d)``,
-    the dict form's value (*d*: the whole dict, for flat siblings) → one argument mapping
-    per operator; ``check(args)``, validated and canonical; ``apply(model, args)``;
-    ``value(stages)``, the dict form's value; ``flat``, the flat form's sibling keys."""
-
-    key: str
-    stages: Callable[[object, Mapping], list]
-    check: Callable[[Mapping], dict]
-    apply: Callable[[BRDF, dict], BRDF]
-    value: Callable[[list], object]
-    flat: tuple = ()
-
-
-def _pump_stages(value, d: Mapping) -> list:
-    if value is None or (isinstance(value, str) and value.strip().lower() in ("", "none")):
-        return []  # a flat "times" without a pump is the page's unused field: not read
-    if isinstance(value, str):
-        times = d.get("times")
-        return [{"g": value, "times": 1 if times is None else times}]
-    if isinstance(value, Mapping):
-        return [value]
-    if isinstance(value, list | tuple) and all(isinstance(s, Mapping) for s in value):
-        return list(value)
-    raise ParameterError(f"pump must be 'max', 'controlled', none, {{'g': G, 'times': K}} or "
-                         f"a list of those; got {value!r}")
-
-
-def _pump_check(args: Mapping) -> dict:
-    unknown = sorted(set(args) - {"g", "times"})
-    if unknown:
-        raise ParameterError(f"pump: unknown argument {unknown[0]!r}; valid: g, times")
-    g = args.get("g", "max")
-    if g == "custom":
-        raise ParameterError("from_dict: a custom g cannot be rebuilt from a dict")
-    if g not in _pumping().G_CHOICES:
-        raise ParameterError(f"pump must be 'max', 'controlled' or none; got {g!r}")
-    times = args.get("times", 1)
-    problem = times_problem(times)
-    if problem is not None:
-        raise ParameterError(f"times {problem}")
-    return {"g": g, "times": int(times)}
-
-
-def _pump_value(stages: list) -> object:
-    return stages[0] if len(stages) == 1 else stages
-
-
-#: The operators a spec applies, by key. Energy compensation, next, is one more entry.
-OPERATORS: dict[str, OperatorKind] = {
-    "pump": OperatorKind("pump", _pump_stages, _pump_check,
-                         lambda m, a: _pumping().pump(m, a["g"], times=a["times"]), _pump_value,
-                         flat=("times",)),
-}
 #: The dict form's keys: the target, its parameters, each operator and its flat siblings.
 _DICT_KEYS = ("model", "params", *OPERATORS, *(s for o in OPERATORS.values() for s in o.flat))
 
@@ -498,20 +427,29 @@ class ModelSpec:
     # --------------------------------------------------------------- words
     @classmethod
     def parse(cls, target, params: Iterable[str] | Mapping = (), pump: str | None = None,
-              times: int | None = None, *, option: str = "-p") -> ModelSpec:
-        """The spec of the command line's ``MODEL -p NAME=VALUE … --pump G --times K``:
-        *target* a name of :data:`KINDS`; *params* ``NAME=VALUE`` words or a mapping
-        (:func:`parse_items`: ``beta`` in degrees); *pump* None, ``"max"`` or
-        ``"controlled"`` (:func:`brdfkit.pumping.pump`) applied *times* times (1 …
+              times: int | None = None, *, option: str = "-p",
+              compensate: str | None = None) -> ModelSpec:
+        """The spec of the command line's ``MODEL -p NAME=VALUE … --compensate M --pump G
+        --times K``: *target* a name of :data:`KINDS`; *params* ``NAME=VALUE`` words or a
+        mapping (:func:`parse_items`: ``beta`` in degrees); *compensate* None or a method
+        (:func:`brdfkit.compensation.compensate`), applied first; *pump* None, ``"max"``
+        or ``"controlled"`` (:func:`brdfkit.pumping.pump`) applied *times* times (1 …
         :data:`MAX_TIMES`, default 1; only with *pump*); *option* is named in the error for
         a malformed item. Raises :class:`BrdfkitError` for an unknown model, a bad
-        parameter, *times* out of range or *times* without *pump* (it would be ignored).
+        parameter or method, *times* out of range or *times* without *pump* (it would be
+        ignored).
         """
         values = parse_items(target, params, option=option)
         if pump is None and times is not None:
             raise BrdfkitError(f"--times {times} needs --pump max or --pump controlled (it says "
                                "how many times to pump); add --pump or drop --times")
-        ops = ()
+        ops: tuple = ()
+        if compensate is not None:
+            methods = _compensation().METHODS
+            if compensate not in methods:
+                raise BrdfkitError(f"--compensate must be one of {', '.join(methods)}; got "
+                                   f"{compensate!r}")
+            ops = (Operator("compensate", (("method", compensate),)),)
         if pump is not None:
             times = 1 if times is None else times
             problem = times_problem(times)
@@ -520,7 +458,7 @@ class ModelSpec:
             choices = _pumping().G_CHOICES
             if pump not in choices:
                 raise BrdfkitError(f"--pump must be one of {', '.join(choices)}; got {pump!r}")
-            ops = (Operator("pump", (("g", pump), ("times", int(times)))),)
+            ops = ops + (Operator("pump", (("g", pump), ("times", int(times)))),)
         return cls(target, values, ops)
 
     @classmethod
@@ -548,7 +486,8 @@ class ModelSpec:
         ``{"model": NAME, "params": {...}}`` plus, per operator of
         :data:`OPERATORS` in the order applied, its key: ``"pump": {"g": G,
         "times": K}``, a list of those, or the flat ``"pump": G`` with
-        ``"times": K`` beside it (``None``/``"none"``: no pumping).
+        ``"times": K`` beside it; ``"compensate": {"method": M}`` or the flat
+        ``"compensate": M`` (``None``/``"none"``: not applied).
 
         Raises
         ------
@@ -588,7 +527,7 @@ class ModelSpec:
     @classmethod
     def of(cls, built: BRDF) -> ModelSpec:
         """The spec of a built model (from its ``to_dict()``): ``of(m).build()`` has
-        ``m``'s values, for every registered, material and pumped model."""
+        ``m``'s values, for every registered, material, pumped and compensated model."""
         if not isinstance(built, BRDF):
             raise ParameterError(f"ModelSpec.of: expected a brdfkit model (BRDF); got "
                                  f"{type(built).__name__}")

@@ -23,7 +23,7 @@ strategies), :mod:`~brdfkit.models.specular` (Lewis's H_s),
 (the one loop generator).
 """
 
-from brdfkit.models._base import BRDF, DerivedBRDF, Lobe, Param, eval_pairs
+from brdfkit.models._base import BRDF, DerivedBRDF, FresnelSplit, Lobe, Param, eval_pairs
 from brdfkit.models._registry import MODELS, model, model_names, register, resolve
 
 # Importing the family modules registers their models, in this order: the order of
@@ -33,5 +33,5 @@ from brdfkit.models import diffuse, phong, blinn, lafortune, grazing  # noqa: E4
 from brdfkit.models import microfacet, vgroove, ward, he_torrance  # noqa: E402,F401,I001
 # isort: on
 
-__all__ = ["BRDF", "DerivedBRDF", "Lobe", "MODELS", "Param", "eval_pairs", "model", "model_names",
-           "register", "resolve"]
+__all__ = ["BRDF", "DerivedBRDF", "FresnelSplit", "Lobe", "MODELS", "Param", "eval_pairs",
+           "model", "model_names", "register", "resolve"]

@@ -28,6 +28,8 @@ Public objects
   :mod:`brdfkit.models._param`, imported here).
 - :class:`BRDF` — the base class of all models; it declares the model protocol.
 - :class:`DerivedBRDF` — the one constructor path for models built from others.
+- :class:`FresnelSplit` — what :meth:`BRDF.fresnel_split` returns: a model with a Fresnel
+  factor as its white (F = 1) form and the factor's moments F₀, F_avg.
 - :func:`eval_pairs`, :func:`eval_pairs_checked`, :func:`checked_driver` — the
   compiled loops over all pairs, defined in :mod:`brdfkit.models._drivers` and
   imported here (the loop :meth:`BRDF.eval` runs: :func:`~brdfkit.models._drivers.loop_driver`).
@@ -37,6 +39,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
@@ -63,8 +66,31 @@ from brdfkit.models._param import (  # noqa: F401  (re-exported: models import t
 )
 from brdfkit.models.sampling import COSINE
 
-__all__ = ["Param", "Lobe", "BRDF", "DerivedBRDF", "checked_driver", "eval_pairs",
-           "eval_pairs_checked"]
+__all__ = ["Param", "Lobe", "BRDF", "DerivedBRDF", "FresnelSplit", "checked_driver",
+           "eval_pairs", "eval_pairs_checked"]
+
+
+@dataclass(frozen=True)
+class FresnelSplit:
+    """A model with a Fresnel factor, split as f = F · f_white (:meth:`BRDF.fresnel_split`).
+
+    Attributes
+    ----------
+    white : BRDF
+        The model with F = 1 (and any scale that multiplies F set to 1): the form whose
+        albedo E(μ) the compensation operators tabulate (Kulla & Conty 2017, §
+        "multiple scattering"; Turquin 2019, eq. 10 uses E of F = 1).
+    f0 : ndarray (C,)
+        F(1), the factor at normal incidence (Turquin's F₀).
+    f_avg : ndarray (C,)
+        2∫₀¹ F(μ) μ dμ, the cosine-weighted average (Kulla & Conty's F_avg).
+
+    C is the model's channel count (1 for a grey model).
+    """
+
+    white: BRDF
+    f0: np.ndarray
+    f_avg: np.ndarray
 
 
 class BRDF:
@@ -110,6 +136,8 @@ class BRDF:
     - :attr:`reciprocal`, :attr:`has_sampler`, :meth:`sample`, :meth:`pdf`.
     - :meth:`formulas` — f_r, sampler and pdf as formulas Dr.Jit can trace
       (:class:`brdfkit._dual.Formulas`), or None (the default).
+    - :meth:`fresnel_split` — the white (F = 1) form and F₀, F_avg of a model with a
+      Fresnel factor, or None (the default: the model is its own white form).
 
     Models built from other models (pumped, measured, fitted, wrapped) derive
     from :class:`DerivedBRDF`, which passes through the same set-up.
@@ -436,6 +464,17 @@ class BRDF:
         wi = COSINE.sample(wo, u)
         wi = np.broadcast_to(wi, np.broadcast_shapes(wi.shape, wo.shape)).copy()
         return wi, self.pdf(wi, wo)
+
+    def fresnel_split(self) -> FresnelSplit | None:
+        """The white (F = 1) form of a model with a Fresnel factor, and F₀ and F_avg.
+
+        Returns a :class:`FresnelSplit` when f = F · f_white with a factor F that the
+        model's parameters set (a Fresnel term, a scale multiplying it); the energy
+        compensation operators (:mod:`brdfkit.compensation`) tabulate the albedo of
+        ``white`` and weight the restored energy with F₀ (Turquin) or F_avg (Kulla–Conty).
+        Default: None — the model is its own white form, F₀ = F_avg = 1.
+        """
+        return None
 
     def formulas(self) -> Formulas | None:
         """eval, sample and pdf as formulas of :mod:`brdfkit._dual` (the Mitsuba bridge traces

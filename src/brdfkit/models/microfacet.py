@@ -40,7 +40,7 @@ from brdfkit.fresnel import _fresnel_conductor
 from brdfkit.halfangle import beckmann_m_from_beta, trowbridge_reitz_c_from_beta
 from brdfkit.models._base import BRDF, VECTOR_OPTIONS, Lobe, Param, _check_beta
 from brdfkit.models._drivers import loop_driver
-from brdfkit.models._params import ETA, packed_indices
+from brdfkit.models._params import ETA, eta_fresnel_split, packed_indices
 from brdfkit.models._registry import register
 from brdfkit.models.microfacet_distributions import (  # noqa: F401 - re-exported
     G1_A_MAX,
@@ -342,6 +342,10 @@ class Microfacet(BRDF):
 
     def lobes(self):
         return [Lobe("half", float(self._values["alpha"]))]
+
+    def fresnel_split(self):
+        """F = ρ_s · F_conductor(η, κ) (1 without η); white: η not given, κ = 0, ρ_s = 1."""
+        return eta_fresnel_split(self, k="k", scale="rho_s")
 
     def formulas(self) -> Formulas:
         """:func:`walter` (this instance's distribution and Fresnel) and its sampler."""

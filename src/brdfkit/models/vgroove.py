@@ -37,7 +37,7 @@ from brdfkit.halfangle import (
     trowbridge_reitz_c_from_beta,
 )
 from brdfkit.models._base import BRDF, VECTOR_OPTIONS, Lobe, Param, _check_beta
-from brdfkit.models._params import ETA_DIELECTRIC, M_SLOPE, packed_indices
+from brdfkit.models._params import ETA_DIELECTRIC, M_SLOPE, eta_fresnel_split, packed_indices
 from brdfkit.models._registry import register
 from brdfkit.models.microfacet_distributions import _HalfVectorSampling, beckmann_lobe
 
@@ -217,6 +217,10 @@ class TorranceSparrow(_HalfVectorSampling, BRDF):
             return "ggx", float(v["c"])  # D₃ ∝ GGX with α = c₃
         return "beckmann", float(v["m"])
 
+    def fresnel_split(self):
+        """F = F_dielectric(η) (1 without η); white: η not given."""
+        return eta_fresnel_split(self)
+
     def lobes(self):
         v = self._values
         dist = v["distribution"]
@@ -349,3 +353,7 @@ class CookTorrance(_HalfVectorSampling, BRDF):
 
     def lobes(self):
         return [Lobe("half", float(beta_from_beckmann_m(self._values["m"])))]
+
+    def fresnel_split(self):
+        """F = ρ_s · F_dielectric(η) (1 without η); white: η not given, ρ_s = 1."""
+        return eta_fresnel_split(self, scale="rho_s")

@@ -6,7 +6,9 @@ Each stage tabulates the albedo of its base once, with the albedo engine, on a
 grid uniform in the shared variable w = √(1 − √(1 − cos θ))
 (:func:`brdfkit.tables.w_of_mu`), split at the albedo's declared kinks, and
 interpolates with cubic splines plus a margin that makes the table an upper
-bound of the albedo (``docs/pumping.md``, "The albedo table").
+bound of the albedo (``docs/pumping.md``, "The albedo table"). With
+``margin=False`` the same builder gives the accurate interpolant itself, which
+the compensation operators tabulate E(μ) with (:mod:`brdfkit.compensation`).
 
 Public objects
 --------------
@@ -140,7 +142,8 @@ def _engine(model, tol: float = ENGINE_TOL) -> Callable:
 
 def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
                        nn_max: int = 8192, kinks_mu=None,
-                       engine_tol: float = ENGINE_TOL) -> AlbedoTable:
+                       engine_tol: float = ENGINE_TOL, margin: bool = True,
+                       who: str = "pumping") -> AlbedoTable:
     """Tabulate the albedo of *model* to interpolation tolerance *tol*.
 
     Parameters
@@ -161,6 +164,12 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
         Accuracy asked of the albedo engine (default :data:`ENGINE_TOL`; the margin
         still assumes :data:`ENGINE_ERR`, so a looser value is for approximate
         tables only, e.g. :mod:`brdfkit.pumping.surrogate`'s).
+    margin : bool, keyword-only
+        True (pumping): add ``delta`` = 2·max_midpoint_error + :data:`ENGINE_ERR`, so the
+        table bounds the albedo from above. False: ``delta`` = 0, the interpolant itself
+        (error ``max_midpoint_error`` at the midpoints, plus the engine's *engine_tol*).
+    who : str, keyword-only
+        The operator named in the errors.
 
     Returns
     -------
@@ -204,7 +213,7 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
             mid = _as_2d(run(theta_of_w(s_mid)))
             n_eval += len(s_mid)
             if not (np.all(np.isfinite(vals)) and np.all(np.isfinite(mid))):
-                raise BrdfkitError(f"pumping: the albedo of {model.name} is not finite on "
+                raise BrdfkitError(f"{who}: the albedo of {model.name} is not finite on "
                                    "[0, 89.9] deg; it cannot be tabulated")
             coeffs = _spline_coeffs(s_nodes, vals, zero_slope_end=hi == 1.0)
             interp = _eval_coeffs(coeffs, np.full(nn, 0.5))  # (nn, C) at the midpoints
@@ -214,7 +223,7 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
             if 2 * nn > nn_max:
                 worst = int(np.argmax(err.max(axis=1)))
                 raise BrdfkitError(
-                    f"pumping: could not tabulate the albedo of {model.name} to {tol:g} "
+                    f"{who}: could not tabulate the albedo of {model.name} to {tol:g} "
                     f"with {nn_max} intervals (error {err.max():.3g} at theta = "
                     f"{math.degrees(theta_of_w(s_mid[worst])):.4f} deg)")
             # the midpoints become nodes of the doubled grid
@@ -230,7 +239,7 @@ def build_albedo_table(model, *, tol: float = INTERP_TOL, nn_start: int = 16,
         max_errs.append(np.abs(interp - mid).max(axis=0))
         maxes.append(np.maximum(vals.max(axis=0), mid.max(axis=0)))
     max_err = np.max(max_errs, axis=0)
-    delta = 2.0 * max_err + ENGINE_ERR
+    delta = 2.0 * max_err + ENGINE_ERR if margin else np.zeros_like(max_err)
     coeffs = np.concatenate(all_coeffs, axis=1)
     coeffs[:, :, 3] += delta[:, None]
     coloured = model.n_channels is not None
