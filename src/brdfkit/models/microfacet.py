@@ -114,23 +114,12 @@ def walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
     alpha, eta, k, scale = p[P_ALPHA], p[P_ETA], p[P_K], p[P_SCALE]
     inv_a2 = 1.0 / (alpha * alpha)
     live = (iz > 0.0) & (oz > 0.0)  # 0 at and below the horizon
-    sx = ix + ox
-    sy = iy + oy
-    sz = iz + oz  # > 0 in live lanes
-    small = sz < SMALL_LENGTH
-    # scale s by 2^600 when short (exact: a power of two): s_z ≥ 5e-324 then becomes
-    # ≥ 2e-143, whose square is a normal number; SMALL_LENGTH·2^600 ≈ 4e40 cannot
-    # overflow when squared. (1/max|s_k| would overflow for a subnormal s.)
-    r = select(small, _TWO_600, 1.0)  # exact 1 on the common path (no rounding added)
-    sx *= r
-    sy *= r
-    sz *= r
+    sx, sy, sz, small = half_sum(ix, iy, iz, ox, oy, oz)
     sxy2 = sx * sx + sy * sy
     sz2 = sz * sz
     l2 = sxy2 + sz2
     if fresnel:
-        cos_d = 0.5 * sqrt(l2) * select(small, _TWO_M600, 1.0)  # ω_i·h = |s|/2
-        f = _fresnel_conductor(select(live, cos_d, 1.0), eta, k)  # 1.0: discarded lanes finite
+        f = _fresnel_conductor(select(live, cos_d_of(l2, small), 1.0), eta, k)  # 1.0: finite
     else:
         f = 1.0
     if ggx:
@@ -143,6 +132,27 @@ def walter(ix, iy, iz, ox, oy, oz, p, ggx, fresnel):
     else:
         v = beckmann_dg_over_cos(iz, oz, sxy2, sz2, alpha, inv_a2, live)
     return select(live, scale * f * v, 0.0)
+
+
+@formula
+def half_sum(ix, iy, iz, ox, oy, oz):
+    """(s_x, s_y, s_z, small): s = ω_i + ω_o, multiplied by 2^600 when s_z < SMALL_LENGTH
+    (*small*; exact: a power of two), the shared first step of the half-vector kernels.
+
+    s_z ≥ 5e-324 then becomes ≥ 2e-143, whose square is a normal number;
+    SMALL_LENGTH·2^600 ≈ 4e40 cannot overflow when squared. (1/max|s_k| would overflow
+    for a subnormal s.) On the common path the factor is exactly 1 (no rounding added).
+    """
+    sz = iz + oz  # > 0 in live lanes
+    small = sz < SMALL_LENGTH
+    r = select(small, _TWO_600, 1.0)
+    return (ix + ox) * r, (iy + oy) * r, sz * r, small
+
+
+@formula
+def cos_d_of(l2, small):
+    """ω_i·h = ω_o·h = |s|/2 from l2 = |s|² of :func:`half_sum`'s (scaled) s."""
+    return 0.5 * sqrt(l2) * select(small, _TWO_M600, 1.0)
 
 
 @formula(**VECTOR_OPTIONS)
@@ -197,6 +207,19 @@ def walter_pdf(ix, iy, iz, ox, oy, oz, alpha, ggx):
     direction reached with ω_o·h < 0 has density 0, Walter eq. 14's Jacobian);
     0 when ω_o is at or below the horizon or ω_i = −ω_o.
     """
+    hx, hy, hz, ok, jac = reflection_jacobian(ix, iy, iz, ox, oy, oz)
+    p = d_of_h(hx, hy, hz, alpha, ggx) * maximum(hz, 0.0) / jac
+    return select(ok, p, 0.0)
+
+
+@formula
+def reflection_jacobian(ix, iy, iz, ox, oy, oz):
+    """(h_x, h_y, h_z, ok, 4|ω_o·h|) of the half-vector samplers' densities p_h(h)/(4|ω_o·h|).
+
+    h = (ω_i + ω_o)/|ω_i + ω_o| as it is (not folded: a direction reached with
+    ω_o·h < 0 has density 0); *ok* false (and the Jacobian 4, finite) when ω_o is at or
+    below the horizon, ω_i = −ω_o or ω_o·h = 0.
+    """
     hx = ix + ox
     hy = iy + oy
     hz = iz + oz
@@ -208,8 +231,7 @@ def walter_pdf(ix, iy, iz, ox, oy, oz, alpha, ggx):
     hz = hz / n
     cos_oh = absolute(ox * hx + oy * hy + oz * hz)
     ok = ok & (cos_oh > 0.0) & (oz > 0.0)
-    p = d_of_h(hx, hy, hz, alpha, ggx) * maximum(hz, 0.0) / (4.0 * select(ok, cos_oh, 1.0))
-    return select(ok, p, 0.0)
+    return hx, hy, hz, ok, 4.0 * select(ok, cos_oh, 1.0)
 
 
 # the sampler and its pdf per distribution (ggx a constant), for Formulas

@@ -193,7 +193,18 @@ def ggx_g1_over_cos(cos_v: float, alpha: float) -> float:
     c = 0 (→ 2/α), where G₁ and c both underflow and G₁/c would be 0/0.
     """
     c2 = cos_v * cos_v
-    return 2.0 / (cos_v + sqrt(c2 + alpha * alpha * maximum(0.0, 1.0 - c2)))  # clamp: rounding
+    return ggx_g1_over_cos_r2(cos_v, alpha * alpha * maximum(0.0, 1.0 - c2))  # clamp: rounding
+
+
+@formula
+def ggx_g1_over_cos_r2(cos_v: float, r2: float) -> float:
+    """G₁(v)/cos θ_v for GGX from r² = α(ω)² sin²θ_v: 2/(c + √(c² + r²)) (Walter eq. 34).
+
+    The form both the isotropic (r² = α² sin²θ_v, :func:`ggx_g1_over_cos`) and the
+    anisotropic distributions (r² = α_x² v_x² + α_y² v_y², the projected roughness
+    α(ω)² = cos²φ α_x² + sin²φ α_y² times sin²θ) share: finite down to c = 0.
+    """
+    return 2.0 / (cos_v + sqrt(cos_v * cos_v + r2))
 
 
 @_jit
@@ -243,10 +254,17 @@ def _beckmann_g1_over_cos(cos_v: float, alpha: float):
     nothing underflows at grazing angles.
     """
     s = sqrt(maximum(0.0, 1.0 - cos_v * cos_v))  # clamp: rounding near the pole
-    a = cos_v / (alpha * s)  # inf at the pole (s = 0): selected away below
+    return _beckmann_g1_over_cos_r(cos_v, alpha * s)
+
+
+@formula
+def _beckmann_g1_over_cos_r(cos_v: float, r: float):
+    """:func:`_beckmann_g1_over_cos` from r = α(ω) sin θ_v (a = cos θ_v/r): α sin θ for the
+    isotropic distribution, √(α_x² v_x² + α_y² v_y²) for the anisotropic one."""
+    a = cos_v / r  # inf at the pole (r = 0): selected away below
     h = _beckmann_h_total(a)
     small = a < G1_A_MAX
-    return select(small, 2.0 * SQRT_PI, 1.0), select(small, alpha * s * h, cos_v)
+    return select(small, 2.0 * SQRT_PI, 1.0), select(small, r * h, cos_v)
 
 
 @formula
@@ -261,13 +279,20 @@ def beckmann_dg_over_cos(iz, oz, sxy2, sz2, alpha, inv_a2, live):
     denominator by 1).
     """
     t = sxy2 / sz2  # tan²θ_h, without the cancellation of (1 − cos²)/cos²
-    e = -t * inv_a2  # −tan²θ_h/α²
+    ni, di = _beckmann_g1_over_cos(iz, alpha)
+    no, do = _beckmann_g1_over_cos(oz, alpha)
+    return beckmann_dg_core(t, -t * inv_a2, alpha * alpha, ni, di, no, do, live)
+
+
+@formula
+def beckmann_dg_core(t, e, a2, ni, di, no, do, live):
+    """The core of :func:`beckmann_dg_over_cos`, shared with the anisotropic distribution:
+    tan²θ_h *t*, the exponent *e* = −tan²θ_h/α² (anisotropic: −((h_x/α_x)² + (h_y/α_y)²)/h_z²),
+    *a2* = α² (α_x α_y), the G₁/cos pairs (ni/di, no/do) of both directions."""
     live = live & (e >= -700.0)  # NaN (0/0, discarded lanes) is not live
     e = select(live, e, -1000.0)  # e^{−1000} = 0 exactly (exp_nonpos)
     sec2 = 1.0 + select(live, t, 0.0)  # 1/cos²θ_h
-    ni, di = _beckmann_g1_over_cos(iz, alpha)
-    no, do = _beckmann_g1_over_cos(oz, alpha)
-    den = 4.0 * PI * (alpha * alpha) * di * do
+    den = 4.0 * PI * a2 * di * do
     den = select(live, den, 1.0)
     return exp_nonpos(e) * (sec2 * sec2) * (ni * no) / den
 
@@ -280,8 +305,15 @@ def d_ggx_of_h(hz2: float, hxy2: float, inv_a2: float, alpha: float) -> float:
     no 1 − cos²θ_h (exact for tiny α) and no underflow (the bracket is ≥
     min(1, 1/α²)/… ≥ 1/16 for α ≤ 4); 1/α² = inf gives D = 0 off the mirror.
     """
-    u = hz2 + hxy2 * inv_a2
-    return 1.0 / (PI * (alpha * alpha) * (u * u))
+    return d_ggx_of_u(hz2 + hxy2 * inv_a2, alpha * alpha)
+
+
+@formula
+def d_ggx_of_u(u: float, a2: float) -> float:
+    """GGX D = 1/(π a2 u²) from u = h_z² + |h_xy|²/α² (isotropic, a2 = α²) or
+    h_z² + (h_x/α_x)² + (h_y/α_y)² (anisotropic, a2 = α_x α_y): Walter eq. (33) and its
+    anisotropic form (Heitz 2014 eq. 85) multiplied out."""
+    return 1.0 / (PI * a2 * (u * u))
 
 
 # =========================================================================== sampling (formulas)
@@ -303,15 +335,21 @@ def d_of_h(hx, hy, hz, alpha, ggx):
     a2 = alpha * alpha
     up = hz > 0.0
     if ggx:
-        u = hz2 + hxy2 / a2  # as d_ggx_of_h: no 1 − cos², ≥ 1/16
-        d = 1.0 / (PI * a2 * (u * u))
+        d = d_ggx_of_u(hz2 + hxy2 / a2, a2)  # as d_ggx_of_h: no 1 − cos², ≥ 1/16
     else:
         t = hxy2 / hz2  # tan²θ_h (NaN or inf only where h_z ≤ 0: selected away)
-        e = -t / a2
-        up = up & (e >= -700.0)  # NaN is not up
-        sec2 = 1.0 + select(up, t, 0.0)  # 1/cos²θ_h
-        d = exp_nonpos(select(up, e, -1000.0)) * (sec2 * sec2) / (PI * a2)
+        d, up = d_beckmann_of_t(t, -t / a2, a2, up)
     return select(up, d, 0.0)
+
+
+@formula
+def d_beckmann_of_t(t, e, a2, up):
+    """Beckmann D = e^{e}(1 + t)²/(π a2) from tan²θ_h *t* and the exponent *e* (−t/α², or
+    −((h_x/α_x)² + (h_y/α_y)²)/h_z² anisotropic, a2 = α_x α_y); ``(D, up)`` with *up*
+    false where e < −700 (D < 1e-290, given as 0) or NaN, as :func:`beckmann_dg_over_cos`."""
+    up = up & (e >= -700.0)  # NaN is not up
+    sec2 = 1.0 + select(up, t, 0.0)  # 1/cos²θ_h
+    return exp_nonpos(select(up, e, -1000.0)) * (sec2 * sec2) / (PI * a2), up
 
 
 @formula
@@ -322,16 +360,21 @@ def sample_half(u0, u1, alpha, ggx):
     eq. 28), φ_h = 2π u₁; cos θ_h = 1/√(1 + tan²θ_h) and sin θ_h = tan θ_h cos θ_h
     (exact for tiny θ_h, no 1 − cos²).
     """
-    u = minimum(u0, U0_MAX)  # clamp: u₀ = 1 maps to θ_h = 90°
-    a2 = alpha * alpha
-    if ggx:
-        tan2 = a2 * u / (1.0 - u)
-    else:
-        tan2 = -a2 * log1p(-u)
+    tan2 = tan2_half(u0, alpha * alpha, ggx)
     cos_h = 1.0 / sqrt(1.0 + tan2)
     sin_h = sqrt(tan2) * cos_h
     phi = TWO_PI * u1
     return sin_h * cos(phi), sin_h * sin(phi), cos_h
+
+
+@formula
+def tan2_half(u0, a2, ggx):
+    """tan²θ_h of the D cos θ_h sampler from u₀ ∈ [0, 1) and a2 = α² (anisotropic: α(φ_h)²):
+    a2 u₀/(1 − u₀) (GGX, Walter eq. 35) or −a2 ln(1 − u₀) (Beckmann, eq. 28)."""
+    u = minimum(u0, U0_MAX)  # clamp: u₀ = 1 maps to θ_h = 90°
+    if ggx:
+        return a2 * u / (1.0 - u)
+    return -a2 * log1p(-u)
 
 
 @_jit
