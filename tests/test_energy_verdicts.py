@@ -181,7 +181,8 @@ def test_rows_are_specs_with_unique_labels_and_known_claims():
     labels = [r["label"] for r in ROWS]
     assert len(labels) == len(set(labels))
     for r in ROWS:
-        assert set(r) == {"label", "group", "spec", "claim"}
+        assert {"label", "group", "spec", "claim"} <= set(r) <= {"label", "group", "spec",
+                                                                 "claim", "tol"}
         assert "model" in r["spec"]
     with pytest.raises(BrdfkitError, match="valid rows"):
         select_rows(["no such row"])

@@ -18,14 +18,15 @@ estimates the albedo engine's (:func:`~brdfkit.analysis.albedo`), E_avg is
   :data:`~brdfkit.analysis.plausibility.RECIPROCITY_TOL` (1e-6).
 - **Energy** — check's verdict (conserves / exceeds / diverges / undetermined), its
   maximum albedo and where (θ_i; for an anisotropic model also φ_i: the albedo is scanned
-  over θ_i on check's grid × φ_i every 15°, and check is run at the φ_i of the maximum),
+  over θ_i on check's grid × φ_i every 30°, and check is run at the φ_i of the maximum),
   with the engine's error estimate at the maximum.
 - **White furnace** — a(θ_i) and the deficit 1 − a(θ_i) at θ_i = 0, 60, 80, 89°
   (:data:`FURNACE_DEG`) for the model as given: the caller gives the white settings
   (ρ = 1, F = 1 as each model has them); a negative deficit is a gain. For an anisotropic
-  model the deficit is of the albedo averaged over φ_i (the 24 azimuths), and its range
+  model the deficit is of the albedo averaged over φ_i (the 12 azimuths), and its range
   over φ_i is recorded. Each with the engine's error estimate.
-- **E_avg** = 2 ∫₀¹ a(μ) μ dμ (ρ_hh, Kulla–Conty's E_avg), with its error estimate.
+- **E_avg** = 2 ∫₀¹ a(μ) μ dμ (ρ_hh, Kulla–Conty's E_avg; an anisotropic model's a
+  averaged over φ_i; rule :data:`E_AVG_RULE`), with its error estimate.
 - **Furnace deviation** (:func:`furnace_deviation`, the figure's energy axis) — the
   1 − a(θ_i) of largest magnitude over θ_i ≤ 89° on check's grid (0, 3, …, 87, 89°).
 
@@ -41,7 +42,7 @@ Public objects
 - :func:`furnace_deviation` — the largest white-furnace |1 − a| over θ_i ≤ 89°, signed.
 - :func:`energy_reciprocity` — the figure's point: furnace deviation and asymmetry.
 - :func:`bound_text` — a value with its accuracy, never more digits than it supports.
-- :data:`FURNACE_DEG`, :data:`ANISO_PHI_DEG`.
+- :data:`FURNACE_DEG`, :data:`ANISO_PHI_DEG`, :data:`E_AVG_RULE`.
 
 References
 ----------
@@ -64,14 +65,20 @@ from brdfkit.errors import BrdfkitError
 from brdfkit.models._base import BRDF
 from brdfkit.status import STATUS
 
-__all__ = ["ANISO_PHI_DEG", "FURNACE_DEG", "EnergyVerdict", "bound_text", "energy_reciprocity",
-           "energy_verdict", "furnace", "furnace_deviation"]
+__all__ = ["ANISO_PHI_DEG", "E_AVG_RULE", "FURNACE_DEG", "EnergyVerdict", "bound_text",
+           "energy_reciprocity", "energy_verdict", "furnace", "furnace_deviation"]
 
 #: The white furnace angles of the table (degrees).
 FURNACE_DEG = (0.0, 60.0, 80.0, 89.0)
 #: Incidence azimuths scanned for an anisotropic model's maximum and furnace (degrees):
-#: every 15°, the full circle (no symmetry of the model is assumed).
-ANISO_PHI_DEG = tuple(float(p) for p in range(0, 360, 15))
+#: every 30°, the full circle (no symmetry of the model is assumed; check then refines θ_i
+#: at the best azimuth).
+ANISO_PHI_DEG = tuple(float(p) for p in range(0, 360, 30))
+#: E_avg's outer rule (Gauss–Legendre nodes in u = √μ, incidence azimuths): the default of
+#: hemispherical_albedo for an isotropic model; for an anisotropic one 24 nodes × 8
+#: azimuths, 288 full-azimuth albedos instead of 1152 (Ashikhmin–Shirley n = 100 took
+#: 300 s with the default), its error estimate (reported) saying what that costs.
+E_AVG_RULE = {True: (48, 16), False: (24, 8)}
 _CODES = STATUS["verdict"]
 
 
@@ -245,7 +252,8 @@ def energy_verdict(model, *, label: str | None = None, tol: float = 1e-7) -> Ene
     phi = _azimuth_of_max(model, tol)
     v = check(model, tol=tol, phi=phi)
     f = furnace(model, tol=tol)
-    h = hemispherical_albedo(model, tol=tol)
+    n, n_phi = E_AVG_RULE[bool(model.isotropic)]
+    h = hemispherical_albedo(model, n=n, n_phi=n_phi, tol=tol)
     # the engine's error estimate at the maximum: one more albedo there (check records the
     # largest estimate over its grid)
     if math.isfinite(v.theta_max_deg):

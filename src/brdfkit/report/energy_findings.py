@@ -85,12 +85,22 @@ def _passes_furnace(r: dict) -> bool:
                                                           r["furnace"]["error"], strict=True))
 
 
-def _compensated(rows: dict, method: str) -> tuple[list[dict], float, float, float]:
+def _compensated(rows: dict, method: str) -> tuple[list[dict], float, float, tuple]:
     rs = _group(rows, "", f" + {method}")
     worst = max(rs, key=lambda r: _worst_abs_deficit(r)[0])
     d, _, e = _worst_abs_deficit(worst)
     asym = [r["max_asymmetry"] for r in rs]
     return rs, d, e, (min(asym), max(asym))
+
+
+def _beyond(rs: list[dict]) -> str:
+    """What check's grid sees beyond the furnace angles (to 89.999°): the largest albedo."""
+    top = max(rs, key=lambda r: r["max_albedo"])
+    if top["max_albedo"] <= 1.0 + top["max_albedo_error"]:
+        return "; a <= 1 on check's whole grid (to 89.999 deg) in every row"
+    return (f"; beyond 89 deg check's grid finds a > 1: max a = {top['max_albedo']:.5f} ± "
+            f"{top['max_albedo_error']:.0e} at {top['theta_max_deg']:g} deg ({top['label']}; "
+            f"{sum(r['energy'] == 'exceeds' for r in rs)} of {len(rs)} rows exceed 1 there)")
 
 
 def _kulla_conty(rows: dict) -> tuple[str, str]:
@@ -99,7 +109,8 @@ def _kulla_conty(rows: dict) -> tuple[str, str]:
     return ("confirmed" if ok else "refuted",
             f"over {len(rs)} rows ({', '.join(r['label'] for r in rs)}): largest |1 - a| at "
             f"0/60/80/89 deg = {d:.2g} (engine error {e:.0e}; criterion {FURNACE_TOL:g}); "
-            f"max relative asymmetry {hi:.2g} (reciprocal when <= {RECIPROCITY_TOL:g})")
+            f"max relative asymmetry {hi:.2g} (reciprocal when <= {RECIPROCITY_TOL:g})"
+            + _beyond(rs))
 
 
 def _turquin(rows: dict) -> tuple[str, str]:
@@ -110,7 +121,7 @@ def _turquin(rows: dict) -> tuple[str, str]:
     which = [r["label"] for r in rs if r["reciprocal"]]
     return (verdict,
             f"over {len(rs)} rows: largest |1 - a| at 0/60/80/89 deg = {d:.2g} (engine error "
-            f"{e:.0e}); max relative asymmetry from {lo:.2g} to {hi:.2g}"
+            f"{e:.0e}); max relative asymmetry from {lo:.2g} to {hi:.2g}" + _beyond(rs)
             + (f"; reciprocal (asymmetry <= {RECIPROCITY_TOL:g}): {', '.join(which)}"
                if which else ""))
 
