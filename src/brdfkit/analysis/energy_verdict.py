@@ -42,7 +42,7 @@ Public objects
 - :func:`furnace_deviation` — the largest white-furnace |1 − a| over θ_i ≤ 89°, signed.
 - :func:`energy_reciprocity` — the figure's point: furnace deviation and asymmetry.
 - :func:`bound_text` — a value with its accuracy, never more digits than it supports.
-- :data:`FURNACE_DEG`, :data:`ANISO_PHI_DEG`, :data:`E_AVG_RULE`.
+- :data:`FURNACE_DEG`, :data:`FURNACE_TOL`, :data:`ANISO_PHI_DEG`, :data:`E_AVG_RULE`.
 
 References
 ----------
@@ -65,11 +65,15 @@ from brdfkit.errors import BrdfkitError
 from brdfkit.models._base import BRDF
 from brdfkit.status import STATUS
 
-__all__ = ["ANISO_PHI_DEG", "E_AVG_RULE", "FURNACE_DEG", "EnergyVerdict", "bound_text",
-           "energy_reciprocity", "energy_verdict", "furnace", "furnace_deviation"]
+__all__ = ["ANISO_PHI_DEG", "E_AVG_RULE", "FURNACE_DEG", "FURNACE_TOL", "EnergyVerdict",
+           "bound_text", "energy_reciprocity", "energy_verdict", "furnace", "furnace_deviation"]
 
 #: The white furnace angles of the table (degrees).
 FURNACE_DEG = (0.0, 60.0, 80.0, 89.0)
+#: The white furnace is passed ("a = 1") when |1 − a(θ)| ≤ this at every furnace angle
+#: (beyond the engine's error): issue 22's criterion for the Kulla–Conty white furnace
+#: (§4, "within 1e-5 of 1").
+FURNACE_TOL = 1e-5
 #: Incidence azimuths scanned for an anisotropic model's maximum and furnace (degrees):
 #: every 30°, the full circle (no symmetry of the model is assumed; check then refines θ_i
 #: at the best azimuth).

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from brdfkit.analysis.energy_verdict import FURNACE_TOL
 from brdfkit.analysis.energy_verdict import energy_reciprocity as _point
 from brdfkit.analysis.plausibility import RECIPROCITY_TOL
 from brdfkit.spec import ModelSpec
@@ -116,6 +117,9 @@ def energy_reciprocity(*, alphas=None, exponents=None):
             _draw_series(strip, ax, pts, method, methods.index(method))
         param = FAMILIES[family][1]
         ax.axvline(RECIPROCITY_TOL, color="grey", ls="--", lw=0.8)
+        for a_ in (strip, ax):  # the "a = 1" criterion of the table
+            a_.axhline(FURNACE_TOL, color="grey", ls=":", lw=0.8)
+        ax.text(2e-17, FURNACE_TOL * 1.3, "a = 1 criterion 1e-5", fontsize=6, color="grey")
         ax.text(RECIPROCITY_TOL * 1.5, 0.98, "reciprocity\ntolerance 1e-6", fontsize=6,
                 color="grey", va="top", transform=ax.get_xaxis_transform())
         ax.set_xscale("log")

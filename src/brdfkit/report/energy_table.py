@@ -46,16 +46,13 @@ import math
 import time
 from collections.abc import Callable, Iterable
 
-from brdfkit.analysis.energy_verdict import FURNACE_DEG, energy_verdict
+from brdfkit.analysis.energy_verdict import FURNACE_DEG, FURNACE_TOL, energy_verdict
 from brdfkit.errors import BrdfkitError
 from brdfkit.spec import ModelSpec
 
 __all__ = ["CLAIMS", "FURNACE_TOL", "ROWS", "energy_table", "format_markdown", "format_table",
            "select_rows", "spec_row"]
 
-#: "a = 1" holds when |1 − a(θ)| ≤ this at every furnace angle (beyond the engine's error):
-#: the issue's criterion for the Kulla–Conty white furnace (§4, "within 1e-5 of 1").
-FURNACE_TOL = 1e-5
 
 #: What each method's paper says of it (the claims checked; None: the paper claims nothing).
 CLAIMS = {
