@@ -259,8 +259,9 @@ def test_defaults_are_inside_bounds_and_examples_build(cls):
     for p in cls.params:
         if p.kind == "choice":
             assert p.default in p.choices, (cls.name, p.name)
-        elif p.default is not None:
-            assert p._inside(float(p.default)), (cls.name, p.name, p.default)
+        elif p.default is not None:  # a colour's default may be per channel (disney's RGB)
+            for x in np.atleast_1d(np.asarray(p.default, dtype=np.float64)):
+                assert p._inside(float(x)), (cls.name, p.name, p.default)
     for ex in cls.examples:
         cls(**ex)
     assert len(cls.examples) >= 1, cls.name

@@ -22,7 +22,7 @@ from brdfkit.models import BRDF, MODELS
 from brdfkit.models._params import DIFFUSE_ALBEDO, DIFFUSE_PART, ETA, packed_indices
 
 DEFAULT_PACKING = [name for name, cls in MODELS.items()
-                   if cls._pack_channel is BRDF._pack_channel
+                   if cls._pack_channel is BRDF._pack_channel and cls._pack is BRDF._pack
                    and all(p.kind != "lobes" for p in cls.params)]
 
 

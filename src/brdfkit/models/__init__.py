@@ -20,6 +20,7 @@ One module per family; every model is registered in :data:`MODELS`.
 - :mod:`~brdfkit.models.microfacet_anisotropic` — Walter's model with the anisotropic
   GGX/Beckmann of :mod:`~brdfkit.models.anisotropic_distributions`;
   :mod:`~brdfkit.models.ashikhmin_shirley` — Ashikhmin & Shirley's anisotropic Phong.
+- :mod:`~brdfkit.models.disney` — Burley's (2012) principled BRDF.
 
 Shared by the families: :mod:`~brdfkit.models.sampling` (importance-sampling
 strategies), :mod:`~brdfkit.models.specular` (Lewis's H_s),
@@ -37,6 +38,7 @@ from brdfkit.models import diffuse, phong, blinn, lafortune, grazing  # noqa: E4
 from brdfkit.models import rough_diffuse  # noqa: E402,F401,I001
 from brdfkit.models import microfacet, vgroove, ward, he_torrance  # noqa: E402,F401,I001
 from brdfkit.models import microfacet_anisotropic, ashikhmin_shirley  # noqa: E402,F401,I001
+from brdfkit.models import disney  # noqa: E402,F401,I001
 # isort: on
 
 __all__ = ["BRDF", "DerivedBRDF", "FresnelSplit", "Lobe", "MODELS", "Param", "eval_pairs",

@@ -15,7 +15,8 @@ that Numba caches on disk (below).
 - :data:`LOOPS` — the loops the generator writes, each from one hand-written
   template: ``"checked"`` and ``"plain"`` (one pair per iteration, parallel over
   pairs), ``"vector"`` (chunks of pairs whose inner loop LLVM vectorises, for
-  branch-free total kernels such as the microfacet models'), ``"blocked"``
+  branch-free total kernels such as the microfacet models'), ``"rgb"`` (the same, for a
+  kernel computing three channels at once from all packed rows), ``"blocked"``
   (locate a block of pairs, then read them: table lookups), ``"albedo"`` (the
   albedo engine's serial loop over incident angles and outgoing nodes).
 - :func:`loop_driver` — the loop *loop* for one kernel with an importable name,
@@ -79,6 +80,7 @@ from pathlib import Path
 
 import numba
 import numpy as np
+from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from brdfkit._cache import bounded_cache, memo
 from brdfkit._threads import numba_threads  # noqa: F401  (re-exported)
@@ -172,21 +174,26 @@ def eval_pairs_checked(kernel, wi, wo, P, out):  # pragma: no cover - compiled
 # AVX2); the directions are read as flat arrays (index 3j + k), which LLVM loads as
 # interleaved groups. Measured on 10 M pairs (microfacet, Beckmann α = 0.1): 2.3x the
 # checked loop on one thread. Templates only (plain functions, never compiled here):
-# `kernel` and `chunk` are the globals of each generated module.
+# `kernel` and `chunk` are the globals of each generated module. "rgb": the same with RGB =
+# True, kernel(…, t) -> (f0, f1, f2) over the rows as one tuple: shared work done once.
 def _vector_chunk(a, b, o, p):  # pragma: no cover - compiled in the generated modules
-    # One channel of the pairs in a and b (flat, 3 per pair) into o; returns the
-    # number of good pairs. What LLVM needs to vectorise this loop, each measured:
-    # its own function (inside the prange body Numba keeps the loop's variables
-    # live after it), indices from 0 (a signed start needs the negative-index
-    # wraparound select, and the loads are no longer an interleaved group),
-    # a unit-stride store, and the count as int64(ok) (not a select of 0 and 1).
+    # The pairs in a and b (flat, 3 per pair) into o; returns the number of good pairs.
+    # LLVM vectorises it given (each measured): its own function (in a prange body Numba keeps
+    # the loop's variables live), indices from 0 (no wraparound select; the loads stay an
+    # interleaved group), unit-stride stores, the count as int64(ok), no loads of p (RGB).
     good = 0
-    for j in range(o.shape[0]):
+    for j in range(o.shape[0] // (3 if RGB else 1)):  # noqa: F821
         ix, iy, iz = a[3 * j], a[3 * j + 1], a[3 * j + 2]
         ox, oy, oz = b[3 * j], b[3 * j + 1], b[3 * j + 2]
         ok = _unit_pair(ix, iy, iz, ox, oy, oz)
-        v = kernel(ix, iy, iz, ox, oy, oz, p)  # noqa: F821 - total: safe for any input
-        o[j] = v if ok else math.nan
+        if RGB:  # noqa: F821 - a constant: Numba prunes the branch not taken; o: (m, 3) flat
+            v0, v1, v2 = kernel(ix, iy, iz, ox, oy, oz, p)  # noqa: F821 - total
+            o[3 * j] = v0 if ok else math.nan  # an interleaved store group
+            o[3 * j + 1] = v1 if ok else math.nan
+            o[3 * j + 2] = v2 if ok else math.nan
+        else:
+            v = kernel(ix, iy, iz, ox, oy, oz, p)  # noqa: F821 - total: safe for any input
+            o[j] = v if ok else math.nan
         good += numba.int64(ok)
     return good
 
@@ -198,6 +205,14 @@ def _vector_loop(wi, wo, P, out):  # pragma: no cover - compiled in the generate
     b = wo.reshape(3 * n)
     n_chunks = (n + _CHUNK - 1) // _CHUNK
     n_good = 0
+    if RGB:  # noqa: F821 - the rows as one tuple of WIDTH = 3 K: no loads in the loop
+        t = to_fixed_tuple(P.reshape(P.size), WIDTH)  # noqa: F821
+        o = out.reshape(3 * n)
+        for q in numba.prange(n_chunks):
+            lo = q * _CHUNK
+            hi = min(n, lo + _CHUNK)
+            n_good += chunk(a[3 * lo:3 * hi], b[3 * lo:3 * hi], o[3 * lo:3 * hi], t)  # noqa: F821
+        return n - n_good
     if n_channels == 1:
         o = out.reshape(n)
         p = P[0]
@@ -293,7 +308,9 @@ LOOPS = {
     "plain": ((("driver", eval_pairs_checked, 'parallel=True, error_model="numpy"'),),
               {"CHECK": False}),
     "vector": ((("chunk", _vector_chunk, "**VECTOR_OPTIONS"),
-                ("driver", _vector_loop, "parallel=True, **VECTOR_OPTIONS")), {}),
+                ("driver", _vector_loop, "parallel=True, **VECTOR_OPTIONS")), {"RGB": False}),
+    "rgb": ((("chunk", _vector_chunk, "**VECTOR_OPTIONS"),
+             ("driver", _vector_loop, "parallel=True, **VECTOR_OPTIONS")), {"RGB": True}),
     "blocked": ((("driver", _blocked_loop, 'parallel=True, error_model="numpy"'),), {}),
     "albedo": ((("driver", _albedo_nodes, 'error_model="numpy"'),), {}),
 }
@@ -363,11 +380,12 @@ import math
 import numba
 import numpy as np
 
-from brdfkit.models._drivers import _CHUNK, VECTOR_OPTIONS, _compose, _unit_pair
+from brdfkit.models._drivers import (_CHUNK, VECTOR_OPTIONS, _compose, _unit_pair,
+                                     to_fixed_tuple)
 '''
 # the globals every generated loop reads, for the loops compiled in memory
-_LOOP_GLOBALS = {"math": math, "numba": numba, "np": np, "_unit_pair": _unit_pair,
-                 "_CHUNK": _CHUNK, "VECTOR_OPTIONS": VECTOR_OPTIONS}
+_LOOP_GLOBALS = {"math": math, "numba": numba, "np": np, "_unit_pair": _unit_pair, "_CHUNK": _CHUNK,
+                 "VECTOR_OPTIONS": VECTOR_OPTIONS, "to_fixed_tuple": to_fixed_tuple}
 
 #: memo key -> (what it was built from, result): the entry holds what it was built from, so
 #: an id() in a key stays that object's while the entry lives; one entry per kernel, loop
@@ -506,16 +524,17 @@ def _name(obj) -> str:
     return f"{py.__module__}.{py.__qualname__}"
 
 
-def loop_driver(kernel, *, loop: str = "checked"):
-    """The loop *loop* (:data:`LOOPS`: ``"checked"``, ``"plain"``, ``"vector"``) for
-    *kernel*: ``driver(wi, wo, P, out) -> n_bad``.
+def loop_driver(kernel, *, loop: str = "checked", width: int = 0):
+    """The loop *loop* (:data:`LOOPS`: ``"checked"``, ``"plain"``, ``"vector"``, ``"rgb"``)
+    for *kernel*: ``driver(wi, wo, P, out) -> n_bad`` (``"rgb"``: P (3, K) passed to the
+    kernel as the flat tuple of its *width* = 3 K values, three channels out, (N, 3)).
 
-    Generated as a module and cached on disk when the kernel has an importable name
-    (the second process loads it in milliseconds); otherwise compiled in memory, the
-    same code. Memoised per kernel and loop.
+    Generated as a module and cached on disk when the kernel has an importable name (the
+    second process loads it in milliseconds); else compiled in memory. Memoised.
     """
-    return _memo((id(kernel), loop), lambda: (kernel, _generate(
-        f"kernel {_name(kernel)}", loop, {"kernel": kernel})["driver"]))
+    bound = {"kernel": kernel, **({"WIDTH": int(width)} if width else {})}
+    return _memo((id(kernel), loop, width), lambda: (kernel, _generate(
+        f"kernel {_name(kernel)}", loop, bound)["driver"]))
 
 
 def blocked_driver(*, state, pair, emit, block: int):
