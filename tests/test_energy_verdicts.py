@@ -256,3 +256,44 @@ def test_energy_reciprocity_figure_renders_small(tmp_path):
 
 def test_findings_not_evaluated_without_rows():
     assert {f["verdict"] for f in findings([])} == {"not evaluated"}
+
+
+# --------------------------------------------------------------------------- rows' models
+def test_disney_diffuse_file_is_the_registered_diffuse_where_schlick_vanishes():
+    """At ω_i = ω_o, cos θ_d = 1: the specular's Schlick factor (1 − cos θ_d)⁵ is 0, and
+    with specular = metallic = sheen = clearcoat = subsurface = 0 the registered disney
+    (its reference's code) is its diffuse term alone, which the file writes from Burley's
+    notes §5.3. Elsewhere the registered model is larger (its specular is >= 0)."""
+    from brdfkit.report.energy_table import DISNEY_DIFFUSE
+
+    file_model = brdfkit.model(DISNEY_DIFFUSE, base_color=1.0, roughness=0.7)
+    ref = brdfkit.model("disney", base_color=1.0, roughness=0.7, specular=0.0)
+    w = _dirs(np.array([0.0, 20.0, 45.0, 70.0, 85.0, 89.5]), np.array([0, 30, 60, 90, 5, 0.0]))
+    a = np.asarray(file_model.eval(w, w)).reshape(-1)
+    b = np.asarray(ref.eval(w, w)).reshape(w.shape[0], -1)[:, 0]
+    np.testing.assert_allclose(a, b, rtol=1e-12)
+    L, V = _dirs(np.array([60.0, 80.0]), np.zeros(2)), _dirs(np.array([70.0, 85.0]),
+                                                             np.array([180.0, 120.0]))
+    fd = np.asarray(file_model.eval(L, V)).reshape(-1)
+    assert np.all(np.asarray(ref.eval(L, V)).reshape(2, -1)[:, 0] > fd)
+    # and at normal incidence, Burley's F_D90 − 1 multiplies (1 − cos θ)⁵ = 0 on the light
+    # side: f_d(N, V) = (1/π)(1 + (F_D90 − 1)(1 − cos θ_v)⁵) with cos²θ_d = (1 + cos θ_v)/2
+    cv = math.cos(math.radians(70.0))
+    fd90m1 = 2 * 0.7 * (1 + cv) / 2 - 0.5
+    n, v = np.array([[0.0, 0.0, 1.0]]), _dirs(np.array([70.0]), np.array([0.0]))
+    assert float(file_model.eval(n, v)[0]) == pytest.approx(
+        (1 + fd90m1 * (1 - cv) ** 5) / math.pi, rel=1e-14)
+
+
+def test_anisotropic_furnace_is_the_azimuthal_mean_with_its_range():
+    from brdfkit.analysis import albedo
+    from brdfkit.analysis.energy_verdict import ANISO_PHI_DEG
+
+    m = brdfkit.model("microfacet-anisotropic", distribution="ggx", alpha_x=0.6, alpha_y=0.2)
+    f = furnace(m, (60.0,))
+    a = np.asarray(albedo(m, np.radians(60.0), phi=np.radians(ANISO_PHI_DEG)).albedo)
+    assert f["albedo"][0] == pytest.approx(a.mean(), abs=1e-14)
+    assert f["deficit_min"][0] == pytest.approx(1 - a.max(), abs=1e-14)
+    assert f["deficit_max"][0] == pytest.approx(1 - a.min(), abs=1e-14)
+    assert a.max() - a.min() > 1e-3  # the azimuth matters for this model
+    assert f["phi_deg"] == list(ANISO_PHI_DEG)

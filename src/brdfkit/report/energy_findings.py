@@ -142,7 +142,7 @@ def _eon(rows: dict) -> tuple[str, str]:
 
 
 def _disney(rows: dict) -> tuple[str, str]:
-    r = _get(rows, "Disney rough, diffuse only")
+    r = _get(rows, "Disney rough, diffuse term")
     f = r["furnace"]
     over = [(t, -d, e) for t, d, e in zip(f["theta_deg"], f["deficit"], f["error"],
                                            strict=True) if -d > e]

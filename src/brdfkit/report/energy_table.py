@@ -43,6 +43,7 @@ References
 from __future__ import annotations
 
 import math
+import pathlib
 import time
 from collections.abc import Callable, Iterable
 
@@ -50,7 +51,7 @@ from brdfkit.analysis.energy_verdict import FURNACE_DEG, FURNACE_TOL, energy_ver
 from brdfkit.errors import BrdfkitError
 from brdfkit.spec import ModelSpec
 
-__all__ = ["CLAIMS", "FURNACE_TOL", "ROWS", "energy_table", "format_markdown", "format_table",
+__all__ = ["CLAIMS", "DISNEY_DIFFUSE", "FURNACE_TOL", "ROWS", "energy_table", "format_markdown", "format_table",
            "select_rows", "spec_row"]
 
 
@@ -96,6 +97,9 @@ def _micro(dist: str, alpha: float, method: str | None) -> dict:
             "claim": method or "walter"}
 
 
+#: Burley's diffuse term alone, a model file beside this module (its docstring says why).
+DISNEY_DIFFUSE = str(pathlib.Path(__file__).with_name("disney_diffuse.py"))
+
 _PHONG = {"model": "modified-phong", "params": {"rho_d": 0.0, "rho_s": 1.0, "n": 20.0}}
 
 #: The table's rows (module docstring): labels unique, specs at white settings.
@@ -135,9 +139,13 @@ ROWS: tuple[dict, ...] = (
     {"label": "Disney rough", "group": "disney",
      "spec": {"model": "disney", "params": {"base_color": 1.0, "roughness": 1.0}},
      "claim": "disney"},
-    {"label": "Disney rough, diffuse only", "group": "disney",
+    {"label": "Disney rough, specular 0", "group": "disney",
      "spec": {"model": "disney",
               "params": {"base_color": 1.0, "roughness": 1.0, "specular": 0.0}},
+     "claim": "disney"},
+    # its diffuse term alone (the registered model keeps a Schlick specular at F0 = 0)
+    {"label": "Disney rough, diffuse term", "group": "disney",
+     "spec": {"model": DISNEY_DIFFUSE, "params": {"base_color": 1.0, "roughness": 1.0}},
      "claim": "disney"},
     # Ashikhmin-Shirley: F = 1 (R_s = 1: the specular alone) and a white diffuse
     # (tol 1e-5: beyond 85° its albedo does not converge below ~1e-5 at 1e-7 either — the
