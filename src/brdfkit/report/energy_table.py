@@ -51,8 +51,8 @@ from brdfkit.analysis.energy_verdict import FURNACE_DEG, FURNACE_TOL, energy_ver
 from brdfkit.errors import BrdfkitError
 from brdfkit.spec import ModelSpec
 
-__all__ = ["CLAIMS", "DISNEY_DIFFUSE", "FURNACE_TOL", "ROWS", "energy_table", "format_markdown", "format_table",
-           "select_rows", "spec_row"]
+__all__ = ["CLAIMS", "DISNEY_DIFFUSE", "FURNACE_TOL", "ROWS", "energy_table", "format_markdown",
+           "format_table", "select_rows", "spec_row"]
 
 
 #: What each method's paper says of it (the claims checked; None: the paper claims nothing).
