@@ -297,3 +297,20 @@ def test_anisotropic_furnace_is_the_azimuthal_mean_with_its_range():
     assert f["deficit_max"][0] == pytest.approx(1 - a.min(), abs=1e-14)
     assert a.max() - a.min() > 1e-3  # the azimuth matters for this model
     assert f["phi_deg"] == list(ANISO_PHI_DEG)
+
+
+def test_turquin_asymmetry_is_one_minus_the_albedo_ratio():
+    """Turquin's factor 1 + F₀(1 − E(μ))/E(μ) at F₀ = 1 is 1/E(μ), taken at ω_i: f_T(L,V) =
+    f(L,V)/E(μ_L), f_T(V,L) = f(V,L)/E(μ_V), and f is reciprocal, so |f_T(L,V) − f_T(V,L)|
+    / max = 1 − min(E(μ_L), E(μ_V))/max(...): over check's pair set (θ up to 89.9°) it is
+    1 − min E/max E, where the pair has f > 0 in both orders. For GGX α = 1, E rises
+    monotonically from θ = 0° to 89.9° (E(0) = 1 − ln 2)."""
+    from brdfkit.analysis import albedo
+
+    base = {"model": "microfacet", "params": {"distribution": "ggx", "alpha": 1.0}}
+    m = brdfkit.ModelSpec.from_dict({**base, "compensate": {"method": "turquin"}}).build()
+    e = np.asarray(albedo(brdfkit.ModelSpec.from_dict(base).build(),
+                          np.radians([0.0, 89.9])).albedo)
+    v = energy_verdict(m)
+    assert v.max_asymmetry == pytest.approx(1.0 - e[0] / e[1], rel=1e-4)
+    assert v.reciprocity == "not reciprocal"

@@ -223,16 +223,30 @@ class EnergyVerdict:
 
 
 def _azimuth_of_max(model, tol: float) -> float:
-    """The incidence azimuth (radians) of the largest albedo over check's θ_i grid ×
-    :data:`ANISO_PHI_DEG` (0 for an isotropic model, which does not depend on it)."""
+    """The incidence azimuth (degrees, one of :data:`ANISO_PHI_DEG`) of the largest albedo
+    over check's θ_i grid × :data:`ANISO_PHI_DEG` (0 for an isotropic model, which does
+    not depend on it). Azimuths whose maximum is within the error estimates of the largest
+    tie (at θ_i = 0 every azimuth gives the same albedo): the first of them is taken."""
     if model.isotropic:
         return 0.0
     phis = _azimuths(model)
     r = albedo(model, np.radians(np.asarray(ENERGY_GRID_DEG))[:, None], phi=phis[None, :],
                tol=tol)
-    a = np.asarray(r.albedo, dtype=np.float64).reshape(len(ENERGY_GRID_DEG), phis.size, -1)
+    shape = (len(ENERGY_GRID_DEG), phis.size, -1)
+    a = np.asarray(r.albedo, dtype=np.float64).reshape(shape)
+    e = np.asarray(r.error, dtype=np.float64).reshape(shape)
     a = np.where(np.isfinite(a), a, np.inf)  # a NaN albedo is where check must look
-    return float(phis[int(np.argmax(a.max(axis=(0, 2))))])
+    flat = a.reshape(-1, phis.size, a.shape[-1]).transpose(1, 0, 2).reshape(phis.size, -1)
+    where = np.argmax(flat, axis=1)  # per azimuth: its largest albedo and that one's error
+    per_phi = flat[np.arange(phis.size), where]
+    err = e.reshape(-1, phis.size, e.shape[-1]).transpose(1, 0, 2).reshape(phis.size, -1)[
+        np.arange(phis.size), where]
+    k = int(np.argmax(per_phi))
+    if np.isfinite(per_phi[k]):
+        # azimuths within the error estimates of the largest tie (at θ_i = 0 all are equal
+        # but for the quadrature's error): the first of them is taken
+        k = int(np.flatnonzero(per_phi >= per_phi[k] - err - err[k])[0])
+    return ANISO_PHI_DEG[k]
 
 
 def energy_verdict(model, *, label: str | None = None, tol: float = 1e-7) -> EnergyVerdict:
@@ -253,7 +267,8 @@ def energy_verdict(model, *, label: str | None = None, tol: float = 1e-7) -> Ene
     EnergyVerdict
     """
     _check_model(model, "energy_verdict")
-    phi = _azimuth_of_max(model, tol)
+    phi_deg = _azimuth_of_max(model, tol)
+    phi = math.radians(phi_deg)
     v = check(model, tol=tol, phi=phi)
     f = furnace(model, tol=tol)
     n, n_phi = E_AVG_RULE[bool(model.isotropic)]
@@ -275,7 +290,7 @@ def energy_verdict(model, *, label: str | None = None, tol: float = 1e-7) -> Ene
         label=label or model.name, model=model.to_dict(), reciprocity=v.reciprocity,
         max_asymmetry=v.max_asymmetry, energy=v.energy, max_albedo=v.max_albedo,
         max_albedo_error=err_max, theta_max_deg=v.theta_max_deg,
-        phi_max_deg=None if model.isotropic else math.degrees(phi),
+        phi_max_deg=None if model.isotropic else phi_deg,
         divergence_exponent=v.divergence_exponent, furnace=f, e_avg=float(e_avg[k]),
         e_avg_error=float(e_err[k]), anisotropic=not model.isotropic, notes=notes,
         status=v.status, detail=v.detail)
