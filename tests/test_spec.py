@@ -264,7 +264,7 @@ def test_dict_errors_name_the_key():
     with pytest.raises(ParameterError, match="expected a dict with a 'model' key"):
         ModelSpec.from_dict({"params": {}})
     with pytest.raises(ParameterError, match="unknown key 'pumped'; valid keys: model, params, "
-                                             "pump, times"):
+                                             "pump, compensate, times"):
         ModelSpec.from_dict({"model": "lambert", "pumped": "max"})
     with pytest.raises(ParameterError, match="lambert: params must be an object NAME: VALUE"):
         ModelSpec.from_dict({"model": "lambert", "params": [1, 2]})
@@ -276,8 +276,10 @@ def test_dict_errors_name_the_key():
         ModelSpec.from_dict({"model": "lambert", "pump": {"g": "max", "k": 2}})
     with pytest.raises(ParameterError, match="a custom g cannot be rebuilt"):
         ModelSpec.from_dict({"model": "lambert", "pump": {"g": "custom", "times": 1}})
-    with pytest.raises(ParameterError, match="unknown operator 'compensate'; valid: pump"):
-        Operator("compensate")
+    with pytest.raises(ParameterError, match="unknown operator 'smooth'; valid: pump, "
+                                             "compensate"):
+        Operator("smooth")
+    assert Operator("compensate").arguments == {"method": "kulla-conty"}  # the default
     with pytest.raises(ParameterError, match="expected a brdfkit model"):
         ModelSpec.of({"model": "lambert"})
     with pytest.raises(ParameterError, match="model must be a model name"):
@@ -315,6 +317,9 @@ def test_batch_jobs_and_explorer_entries_are_specs():
     assert entry_spec(entry) == want
     assert entry_spec({"spec": "modified-phong", "params": {"beta": 30}, "pump": None,
                        "times": 1}) == ModelSpec.parse("modified-phong", ["beta=30"])
+    assert entry_spec({"spec": "modified-phong", "params": {"n": 20}, "compensate": "turquin",
+                       "pump": None}) == ModelSpec.parse("modified-phong", ["n=20"],
+                                                         compensate="turquin")
 
 
 def test_mitsuba_plugin_properties_are_the_spec_vocabulary():

@@ -56,7 +56,8 @@ Public objects
 - :func:`times_problem` — why a number of pumpings is invalid, or None.
 - :func:`is_material_spec` — whether a name is a material spec.
 - :data:`KINDS`, :class:`SpecKind`; :data:`OPERATORS`, :class:`OperatorKind`.
-- :data:`SPEC_FORMS`, :data:`PUMP_CHOICES`, :data:`MAX_TIMES`, :data:`TIMES_REASON`.
+- :data:`SPEC_FORMS`, :data:`PUMP_CHOICES`, :data:`MAX_TIMES`, :data:`TIMES_REASON`,
+  :data:`COMPENSATE_CHOICES` (the compensation methods).
 """
 
 from __future__ import annotations
@@ -88,12 +89,15 @@ from brdfkit.spec_words import parse_words, property_value
 __all__ = ["ModelSpec", "Operator", "model", "model_params", "canonical_name", "parse_items",
            "property_value", "times_problem", "is_material_spec", "KINDS", "SpecKind", "OPERATORS",
            "OperatorKind", "SPEC_FORMS", "PUMP_CHOICES", "MAX_TIMES",  # noqa: F822 (lazy)
+           "COMPENSATE_CHOICES",  # noqa: F822 (lazy)
            "TIMES_REASON"]
 
 #: How a material spec is written (for error messages and help texts).
 SPEC_FORMS = ("merl:NAME[@nbrdf|@npf|@abc|@sgd], rgl:NAME, nielsen:NAME or a path to a "
               "MERL .binary file ('brdfkit materials' lists the built-in ones)")
 def __getattr__(name: str):
+    if name == "COMPENSATE_CHOICES":
+        return tuple(_compensation().METHODS)
     if name in ("PUMP_CHOICES", "MAX_TIMES"):
         return tuple(_pumping().G_CHOICES) if name == "PUMP_CHOICES" else _pumping().MAX_TIMES
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

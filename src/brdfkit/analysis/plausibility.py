@@ -110,6 +110,8 @@ class Verdict:
     theta_min_deg: float = 0.0
     #: The pumping stages of a pumped model (``PumpedBRDF.to_dict()["pump"]``), else None.
     pump: dict | list | None = None
+    #: The compensation of a compensated model (``to_dict()["compensate"]``), else None.
+    compensate: dict | None = None
     status: int = 0
     detail: str = ""
     #: The incidence azimuth of the energy part (radians), and whether the model is
@@ -153,6 +155,7 @@ class Verdict:
             "theta_min_deg": float(self.theta_min_deg),
             **({"phi_deg": math.degrees(self.phi)}
                if self.anisotropic or self.phi != 0.0 else {}),
+            **({"compensate": self.compensate} if self.compensate is not None else {}),
             **({"pump": self.pump} if self.pump is not None else {}),
             "status": int(self.status),
             "success": self.success,
@@ -290,7 +293,8 @@ def check(model, *, tol: float = 1e-7, phi: float = 0.0) -> Verdict:
             model=d["model"], params=d["params"], reciprocity=recip,
             max_asymmetry=asym, energy="undetermined", max_albedo=float("nan"),
             theta_max_deg=float("nan"), divergence_exponent=None, max_scale=None, notes=notes,
-            albedo_error=float("inf"), pump=d.get("pump"), status=_CODES.NONFINITE,
+            albedo_error=float("inf"), pump=d.get("pump"), compensate=d.get("compensate"),
+            status=_CODES.NONFINITE,
             detail="energy undetermined: the albedo is NaN or infinite", **aniso)
 
     # --- divergence from the asymptotics, per channel
@@ -380,7 +384,7 @@ def check(model, *, tol: float = 1e-7, phi: float = 0.0) -> Verdict:
         divergence_exponent=p_rounded, max_scale=max_scale, notes=notes, grazing=grazing,
         slopes=slopes_worst, peaks_at_normal=peaks, albedo_error=err,
         min_albedo=float(a.min(axis=1)[kmin]), theta_min_deg=float(grid[kmin]),
-        pump=d.get("pump"),
+        pump=d.get("pump"), compensate=d.get("compensate"),
         status=_CODES.UNDETERMINED if open_parts else _CODES.CONVERGED,
         detail=", ".join(open_parts), **aniso,
     )

@@ -4,12 +4,12 @@ Every command that works on one model reuses these pieces so that models are
 named, parameterised and reported the same way everywhere:
 
 - :func:`model_options` — decorator adding the ``MODEL`` argument and the
-  ``-p/--param NAME=VALUE``, ``--pump [max|controlled]`` and ``--times K``
-  options.
+  ``-p/--param NAME=VALUE``, ``--compensate METHOD``, ``--pump [max|controlled]``
+  and ``--times K`` options.
 - :func:`parse_param_items` — ``NAME=VALUE`` strings → keyword arguments
   (numbers, comma-separated per-channel/per-lobe lists, choice words; ``beta``
   in degrees → radians): :func:`brdfkit.spec.parse_items`.
-- :func:`build_model` — the model, optionally pumped: a
+- :func:`build_model` — the model, optionally compensated and pumped: a
   :class:`brdfkit.spec.ModelSpec` parsed from the words and built.
 - :func:`parse_direction` — ``THETA,PHI`` in degrees → unit vector.
 - :func:`emit_json` / :func:`to_jsonable` — JSON output (NumPy → lists,
@@ -33,6 +33,7 @@ from brdfkit._io import to_jsonable
 from brdfkit.cli._group import EXIT_USAGE
 from brdfkit.errors import BrdfkitError
 from brdfkit.spec import (
+    COMPENSATE_CHOICES,
     MAX_TIMES,
     PUMP_CHOICES,
     TIMES_REASON,
@@ -42,6 +43,7 @@ from brdfkit.spec import (
 )
 
 __all__ = [
+    "COMPENSATE_HELP",
     "EXIT_USAGE",
     "PUMP_MAX_TIMES",
     "THETA_MAX_DEG",
@@ -72,6 +74,11 @@ PARAM_HELP = (
 )
 
 
+COMPENSATE_HELP = ("Compensate the energy lost to multiple scattering before any pumping: "
+                   "'kulla-conty' (adds a reciprocal lobe) or 'turquin' (scales the lobe; "
+                   "not reciprocal); docs/compensation.md.")
+
+
 # --------------------------------------------------------------------------- parameters
 def parse_param_items(model_name: str, items: Iterable[str] | Mapping, *,
                       option: str = "-p") -> dict:
@@ -82,8 +89,8 @@ def parse_param_items(model_name: str, items: Iterable[str] | Mapping, *,
 
 
 def build_model(name: str, params: Iterable[str] | Mapping = (), pump: str | None = None,
-                times: int | None = None):
-    """Build model *name* from command-line parameters, pumped if asked: the
+                times: int | None = None, compensate: str | None = None):
+    """Build model *name* from command-line parameters, compensated and pumped if asked: the
     :class:`~brdfkit.spec.ModelSpec` of the words (:meth:`~brdfkit.spec.ModelSpec.parse`),
     built.
 
@@ -93,7 +100,8 @@ def build_model(name: str, params: Iterable[str] | Mapping = (), pump: str | Non
         Unknown model, bad parameter, *times* out of range, or *times*
         given without *pump* (it would be silently ignored).
     """
-    return ModelSpec.parse(name, params, pump=pump, times=times).build()
+    return ModelSpec.parse(name, params, pump=pump, times=times,
+                           compensate=compensate).build()
 
 
 def _times_callback(ctx: click.Context, param: click.Parameter, value):
@@ -104,10 +112,11 @@ def _times_callback(ctx: click.Context, param: click.Parameter, value):
 
 
 def model_options(func: Callable) -> Callable:
-    """Decorator adding ``MODEL``, ``-p/--param``, ``--pump`` and ``--times`` to a command.
+    """Decorator adding ``MODEL``, ``-p/--param``, ``--compensate``, ``--pump`` and
+    ``--times`` to a command.
 
-    The command receives ``model`` (str), ``param`` (tuple of str), ``pump``
-    (str or None) and ``times`` (int, or None when not given); pass them to
+    The command receives ``model`` (str), ``param`` (tuple of str), ``compensate`` (str or
+    None), ``pump`` (str or None) and ``times`` (int, or None when not given); pass them to
     :func:`build_model`.
     """
     func = click.option("--times", type=int, default=None, callback=_times_callback,
@@ -117,6 +126,8 @@ def model_options(func: Callable) -> Callable:
     func = click.option("--pump", type=click.Choice(list(PUMP_CHOICES)), default=None,
                         help="Pump up the albedo (Neumann et al. 1999, eqs. 16-21) with "
                              "g1 ('max') or g2 ('controlled').")(func)
+    func = click.option("--compensate", type=click.Choice(list(COMPENSATE_CHOICES)),
+                        default=None, help=COMPENSATE_HELP)(func)
     func = click.option("-p", "--param", "param", multiple=True, metavar="NAME=VALUE",
                         help=PARAM_HELP)(func)
     func = click.argument("model", metavar="MODEL")(func)

@@ -24,9 +24,9 @@ import click
 import numpy as np
 
 import brdfkit.cli._progress as _progress
-from brdfkit.cli._common import build_model, emit_json, model_options
+from brdfkit.cli._common import COMPENSATE_HELP, build_model, emit_json, model_options
 from brdfkit.errors import BrdfkitError
-from brdfkit.spec import PUMP_CHOICES, ModelSpec
+from brdfkit.spec import COMPENSATE_CHOICES, PUMP_CHOICES, ModelSpec
 
 __all__ = ["MAX_ANGLES", "parse_theta", "parse_phi", "albedo_cmd", "check_cmd", "table2_cmd",
            "figure_cmd"]
@@ -39,6 +39,11 @@ MAX_ANGLES = 100_000
 _THETA_FORMS = ("--theta must be START:STOP:COUNT (COUNT angles, inclusive, like "
                 "numpy.linspace) or a comma-separated list, in degrees (e.g. 0:89.9:90 or "
                 "0,30,60)")
+
+
+def _compensated(d: dict) -> str:
+    """The text outputs' note of a compensation (none when the model has none)."""
+    return f"  compensated ({d['compensate']['method']})" if "compensate" in d else ""
 
 
 def parse_theta(text: str) -> np.ndarray:
@@ -126,7 +131,7 @@ def _phi_note(m, phi_deg: float) -> str | None:
 @click.option("--plot", "plot", default=None, metavar="FILE",
               help="Also write a plot of a(theta_i) to FILE (.png or .svg; the directory "
                    "must exist).")
-def albedo_cmd(model, param, pump, times, theta, phi, tol, as_json, as_csv, plot):
+def albedo_cmd(model, param, compensate, pump, times, theta, phi, tol, as_json, as_csv, plot):
     """Directional albedo a(theta_i) = int f_r cos(theta_o) dw_o of MODEL, with error estimates.
 
     Deterministic lobe-aware quadrature (accurate to ~1e-7). Example:
@@ -138,7 +143,7 @@ def albedo_cmd(model, param, pump, times, theta, phi, tol, as_json, as_csv, plot
     if as_json and as_csv:
         raise BrdfkitError("give at most one of --json and --csv")
     phi_deg = parse_phi(phi)
-    m = build_model(model, param, pump=pump, times=times)
+    m = build_model(model, param, pump=pump, times=times, compensate=compensate)
     th = parse_theta(theta)
     if plot:
         check_output_path(plot, option="--plot")  # fail before the quadrature, not after
@@ -156,7 +161,7 @@ def albedo_cmd(model, param, pump, times, theta, phi, tol, as_json, as_csv, plot
     unconverged = {k: v for k, v in r.to_dict().items() if k in ("status", "message")}
     if as_json:
         emit_json({"model": d["model"], "params": d["params"],
-                   **({"pump": d["pump"]} if "pump" in d else {}),
+                   **{k: d[k] for k in ("compensate", "pump") if k in d},
                    "theta_deg": th, **({"phi_deg": phi_deg} if with_phi else {}),
                    "albedo": a, "error": e, **unconverged})
         return
@@ -175,7 +180,7 @@ def albedo_cmd(model, param, pump, times, theta, phi, tol, as_json, as_csv, plot
             click.echo(",".join([f"{th[k]:.10g}", *([f"{phi_deg:.10g}"] if with_phi else [])]
                                 + [f"{v:.12g}" for v in vals]))
         return
-    click.echo(f"# {d['model']} {d['params']}")
+    click.echo(f"# {d['model']} {d['params']}{_compensated(d)}")
     note = _phi_note(m, phi_deg)
     if note:
         click.echo(f"# note: {note}")
@@ -225,7 +230,7 @@ def _plot_albedo(th, a, name, path, phi_deg=None):
               help='Print {"model", "params", "reciprocal", "max_asymmetry", "energy", '
                    '"max_albedo", "theta_max_deg", "divergence_exponent", "max_scale", '
                    '"notes", ...}.')
-def check_cmd(model, param, pump, times, phi, as_json):
+def check_cmd(model, param, compensate, pump, times, phi, as_json):
     """Plausibility verdict of MODEL: reciprocity, energy conservation, objections.
 
     energy is 'conserves' (max albedo <= 1), 'exceeds' (bounded; max_scale is
@@ -235,13 +240,13 @@ def check_cmd(model, param, pump, times, phi, as_json):
     from brdfkit.analysis import check
 
     phi_deg = parse_phi(phi)
-    m = build_model(model, param, pump=pump, times=times)
+    m = build_model(model, param, pump=pump, times=times, compensate=compensate)
     v = check(m, phi=np.radians(phi_deg))
     d = v.to_dict()
     if as_json:
         emit_json(d)
         return
-    click.echo(f"model:        {d['model']}  {d['params']}")
+    click.echo(f"model:        {d['model']}  {d['params']}{_compensated(d)}")
     if not m.isotropic:
         click.echo(f"azimuth:      phi = {phi_deg:g} deg (anisotropic: the energy verdict is "
                    "at this incidence azimuth)")
@@ -311,10 +316,12 @@ def table2_cmd(as_json, as_md, models):
               help="Resolution of PNG output, 30 to 1200.")
 @click.option("--model", "model", default=None, metavar="SPEC",
               help="For figures of a given model ('slices'): a model name or material spec "
-                   "(merl:nickel, rgl:NAME, nielsen:NAME, a .binary file); -p, --pump and "
-                   "--times apply to it.")
+                   "(merl:nickel, rgl:NAME, nielsen:NAME, a .binary file); -p, --compensate, "
+                   "--pump and --times apply to it.")
 @click.option("-p", "--param", "param", multiple=True, metavar="NAME=VALUE",
               help="Parameter of --model (repeatable), as in 'brdfkit eval'.")
+@click.option("--compensate", type=click.Choice(list(COMPENSATE_CHOICES)), default=None,
+              help="Compensate --model (" + COMPENSATE_HELP + ")")
 @click.option("--pump", type=click.Choice(list(PUMP_CHOICES)), default=None,
               help="Pump --model's albedo up (g1 'max' or g2 'controlled').")
 @click.option("--times", type=int, default=None, metavar="K",
@@ -329,7 +336,7 @@ def table2_cmd(as_json, as_md, models):
                    "(default 320).")
 @click.option("--seed", type=click.IntRange(min=0), default=None, metavar="K",
               help="Monte-Carlo figures (neumann-fig8): the sampler's seed (default 0).")
-def figure_cmd(name, out, dpi, model, param, pump, times, compare, spp, size, seed):
+def figure_cmd(name, out, dpi, model, param, compensate, pump, times, compare, spp, size, seed):
     """Reproduce a paper figure by computation and write it to FILE (PNG or SVG).
 
     NAME is one of the registered figures (e.g. lewis-fig3 ... lewis-fig10,
@@ -363,13 +370,15 @@ def figure_cmd(name, out, dpi, model, param, pump, times, compare, spp, size, se
                            f"brdfkit figure {name} --out {name}.png")
     key = resolve_figure(name)  # name and path are checked before the "building" line
     check_output_path(out, option="--out")
-    if model is None and (param or pump or times is not None or compare):
-        raise BrdfkitError("-p, --pump, --times and --compare describe --model; give --model "
+    if model is None and (param or compensate or pump or times is not None or compare):
+        raise BrdfkitError("-p, --compensate, --pump, --times and --compare describe --model; "
+                           "give --model "
                            "SPEC (figures that take one: " + ", ".join(MODEL_FIGURES) + ")")
     if key in MODEL_FIGURES and model is None:
         raise BrdfkitError(f"figure {key} draws a given model: add --model SPEC (e.g. --model "
                            "merl:nickel)")
-    models = () if model is None else (build_model(model, param, pump=pump, times=times),
+    models = () if model is None else (build_model(model, param, pump=pump, times=times,
+                                                   compensate=compensate),
                                        *(build_model(s) for s in compare))
     options = {k: v for k, v in (("spp", spp), ("size", size), ("seed", seed)) if v is not None}
     own_bar = key in FIGURE_OPTIONS  # the Monte-Carlo figures draw their own progress bar

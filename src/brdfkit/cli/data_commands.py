@@ -64,7 +64,7 @@ def materials_cmd(specs, representations, as_json):
               help="Output MERL .binary file (written atomically; the directory must exist).")
 @click.option("--json", "as_json", is_flag=True,
               help='Print {"model", "params", "out", "seconds", "normal_albedo"}.')
-def export_cmd(model, param, pump, times, out, as_json):
+def export_cmd(model, param, compensate, pump, times, out, as_json):
     """Write MODEL (a model, pumped model or material) onto the MERL grid as FILE.binary.
 
     Each bin holds f_r at the centre of its index coordinates (theta_h =
@@ -75,14 +75,14 @@ def export_cmd(model, param, pump, times, out, as_json):
     FILE.binary ...' reads it back.
     """
     check_output_path(out, option="--out", suffixes=(".binary",))
-    m = build_model(model, param, pump=pump, times=times)
+    m = build_model(model, param, pump=pump, times=times, compensate=compensate)
     t0 = time.perf_counter()
     path = export_merl(m, out)
     seconds = time.perf_counter() - t0
     if as_json:
         d = m.to_dict()
         emit_json({"model": d["model"], "params": d["params"],
-                   **({"pump": d["pump"]} if "pump" in d else {}), "out": path,
+                   **{k: d[k] for k in ("compensate", "pump") if k in d}, "out": path,
                    "seconds": seconds, "normal_albedo": normal_albedo(material(path))})
         return
     click.echo(path)

@@ -18,10 +18,10 @@ import math
 import click
 
 import brdfkit.cli._progress as _progress
-from brdfkit.cli._common import PARAM_HELP, emit_json
+from brdfkit.cli._common import COMPENSATE_HELP, PARAM_HELP, emit_json
 from brdfkit.errors import BrdfkitError
 from brdfkit.fitting import LOSSES, PROCEDURES  # the registries' names (--loss, --procedure)
-from brdfkit.spec import PUMP_CHOICES, ModelSpec, canonical_name, parse_items
+from brdfkit.spec import COMPENSATE_CHOICES, PUMP_CHOICES, ModelSpec, canonical_name, parse_items
 
 __all__ = ["fit_cmd"]
 
@@ -34,6 +34,9 @@ __all__ = ["fit_cmd"]
               help="Start a parameter at VALUE and fit it (-p holds it instead); frees an "
                    "optional one that is off by default, e.g. --start eta=1.5 fits a "
                    "Fresnel index.")
+@click.option("--compensate", type=click.Choice(list(COMPENSATE_CHOICES)), default=None,
+              help="Fit the compensated model (its base parameters are fitted; one fit). "
+                   + COMPENSATE_HELP)
 @click.option("--pump", type=click.Choice(list(PUMP_CHOICES)), default=None,
               help="Fit the pumped model (its base parameters are fitted).")
 @click.option("--times", type=int, default=None, metavar="K", help="Pump K times (with --pump).")
@@ -62,8 +65,8 @@ __all__ = ["fit_cmd"]
               help="Batch: local worker processes.")
 @click.option("--scheduler", default=None, metavar="ADDRESS",
               help="Batch: run on this Dask distributed scheduler (tcp://host:8786) instead.")
-def fit_cmd(models, param, start, pump, times, to, loss, procedure, seed, starts, theta_max,
-            as_json, plot, out, workers, scheduler):
+def fit_cmd(models, param, start, compensate, pump, times, to, loss, procedure, seed, starts,
+            theta_max, as_json, plot, out, workers, scheduler):
     """Fit MODEL's parameters to a measured material (-p NAME=VALUE holds a parameter,
     --start NAME=VALUE starts it there and fits it).
 
@@ -79,6 +82,9 @@ def fit_cmd(models, param, start, pump, times, to, loss, procedure, seed, starts
 
     targets = expand_targets(to)
     if out is not None or len(models) > 1 or len(targets) > 1:
+        if compensate is not None:
+            raise BrdfkitError("--compensate is for one fit (one MODEL, one SPEC); a batch does "
+                               "not take it")
         _batch(models, targets, param=param, start=start, pump=pump, times=times, loss=loss,
                procedure=procedure, seed=seed, theta_max=theta_max, as_json=as_json,
                plot=plot, out=out, workers=workers, scheduler=scheduler)
@@ -99,7 +105,8 @@ def fit_cmd(models, param, start, pump, times, to, loss, procedure, seed, starts
     if both:
         raise BrdfkitError(f"{', '.join(both)}: given with both -p (held) and --start (fitted); "
                            "use one")
-    spec = ModelSpec.parse(model, {**started, **held}, pump=pump, times=times)
+    spec = ModelSpec.parse(model, {**started, **held}, pump=pump, times=times,
+                           compensate=compensate)
     m = spec.build()
     # a held beta (half-angle) is held as the width parameter the spec resolved it into
     width = next(iter(set(spec.params) - set(started) - set(held)), None)

@@ -137,8 +137,8 @@ def _file_models(file: str, as_json: bool) -> None:
               help="Direction toward the viewer: polar angle and azimuth, in DEGREES.")
 @click.option("--json", "as_json", is_flag=True,
               help='Print {"model": ..., "params": {...}, "value": ...} (a list per channel).')
-def eval_cmd(model: str, param: tuple[str, ...], pump: str | None, times: int, wi: str, wo: str,
-             as_json: bool) -> None:
+def eval_cmd(model: str, param: tuple[str, ...], compensate: str | None, pump: str | None,
+             times: int, wi: str, wo: str, as_json: bool) -> None:
     """Evaluate the BRDF f_r(wi, wo) of MODEL in 1/sr (without the cosine factor).
 
     Example: brdfkit eval modified-phong -p rho_s=0.5 -p n=50 --wi 30,0 --wo 30,180
@@ -147,14 +147,14 @@ def eval_cmd(model: str, param: tuple[str, ...], pump: str | None, times: int, w
     the direction is below the horizon and the BRDF is 0 there. PHI is the
     azimuth in degrees. 'beta' is given in degrees here.
     """
-    m = build_model(model, param, pump=pump, times=times)
+    m = build_model(model, param, pump=pump, times=times, compensate=compensate)
     vi = parse_direction(wi, "--wi")
     vo = parse_direction(wo, "--wo")
     value = m.eval(vi, vo)
     if as_json:
         d = m.to_dict()
         emit_json({"model": d["model"], "params": d["params"],
-                   **({"pump": d["pump"]} if "pump" in d else {}), "value": value})
+                   **{k: d[k] for k in ("compensate", "pump") if k in d}, "value": value})
         return
     v = value.tolist() if hasattr(value, "tolist") else value
     click.echo(" ".join(repr(float(x)) for x in v) if isinstance(v, list) else repr(float(v)))

@@ -76,8 +76,8 @@ def render_group() -> None:
               help="Output file: .png (sRGB), .exr (linear, 32-bit float) or .npy (linear, "
                    "float64). Written atomically.")
 @click.option("--json", "as_json", is_flag=True, help="Print the render's metadata as JSON.")
-def sphere_cmd(model, param, pump, times, phi_l, ambient, irradiance, size, engine, spp, seed,
-               exposure, out, as_json):
+def sphere_cmd(model, param, compensate, pump, times, phi_l, ambient, irradiance, size, engine,
+               spp, seed, exposure, out, as_json):
     """Render MODEL on Lewis's sphere test configuration (Lewis 1993, Fig. 2).
 
     An S x S orthographic image of the unit sphere seen from +z, one
@@ -102,7 +102,7 @@ def sphere_cmd(model, param, pump, times, phi_l, ambient, irradiance, size, engi
         raise BrdfkitError(f"--size must be an integer from 1 to {MAX_SIZE} pixels; got {size}")
     rule = parse_exposure(exposure)
     _io.check_output_path(out, option="--out", suffixes=SUFFIXES)  # before any work
-    m = build_model(model, param, pump, times)
+    m = build_model(model, param, pump, times, compensate)
     result = render_sphere(m, phi_l=math.radians(phi_l), ambient=ambient,
                            irradiance=irradiance, size=size, engine=engine, spp=spp, seed=seed)
     k, how = None, ""

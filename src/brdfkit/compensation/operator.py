@@ -155,7 +155,12 @@ class CompensatedBRDF(DerivedBRDF):
         self.constant = spec.constant(self)
         kernel = driver = None
         if base.kernel is not None:
-            kernel, driver = spec.kernel(base.kernel, base.packed.shape[1])
+            # a base whose eval is a formula (branch-free and total: the _dual contract)
+            # composes into the vectorising loop, like its own eval (microfacet's)
+            formulas = base.formulas()
+            vector = formulas is not None and formulas.eval is not None
+            kernel, driver = spec.kernel(formulas.eval if vector else base.kernel,
+                                         base.packed.shape[1], vector=vector)
         own = ("its own white form: all energy missing from its albedo (absorption "
                "included) is treated as lost to unmodelled multiple scattering, so its "
                "white furnace goes to 1 in every channel" if split is None else
@@ -169,6 +174,9 @@ class CompensatedBRDF(DerivedBRDF):
             has_sampler=base.has_sampler, isotropic=True, has_delta=base.has_delta,
             width_param=base.width_param, kernel=kernel)
         self._driver = driver
+        # the base's channels (a material declares them by its packed rows, not by colour
+        # parameters, which the shared set-up counts)
+        self.n_channels = base.n_channels
         self.albedo_kinks = base.albedo_kinks
         self.albedo_kink_mus = base.albedo_kink_mus
 
@@ -187,7 +195,7 @@ class CompensatedBRDF(DerivedBRDF):
     # -------------------------------------------------------------- evaluation
     def _e(self, mu) -> np.ndarray:
         """Ẽ(μ) per row of ``packed``: shape ``mu.shape + (C,)``."""
-        e = self.table(mu)
+        e = self.table(mu)  # clamped at 1, as the kernels read it
         return np.broadcast_to(e, (*e.shape[:-1], self.packed.shape[0]))
 
     def eval(self, wi, wo) -> np.ndarray:

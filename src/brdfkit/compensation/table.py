@@ -13,12 +13,14 @@ already has (``docs/compensation.md``, "Tables and their accuracy"):
    they meet :data:`TABLE_TOL` at every interval midpoint — pumping's
    :func:`~brdfkit.pumping.table.build_albedo_table` with ``margin=False``: the
    accurate interpolant, not pumping's upper bound;
-2. the kernel's :class:`~brdfkit.tables.Lookup` of that spline (a lower bound of it
-   within :data:`~brdfkit.tables.LUT_TOL`, so that 1 − E ≥ 0 wherever E ≤ 1);
-3. E_avg integrated *from the lookup itself*, exactly (3-point Gauss–Legendre on
-   each of its cubic pieces: E·μ is a quartic there). So the Kulla–Conty lobe's own
-   normalisation 2∫(1 − Ẽ)μ dμ = 1 − E_avg holds to rounding with the Ẽ the kernel
-   reads, and the compensated furnace error is the table's pointwise error only.
+2. the kernel's :class:`~brdfkit.tables.Lookup` of min(E, 1) (an upper bound of it
+   within :data:`~brdfkit.tables.LUT_TOL`; the kernels clamp what they read at 1, so
+   Ẽ ≥ min(E, 1) and 0 ≤ 1 − Ẽ);
+3. E_avg integrated *from the clamped lookup itself* (3-point Gauss–Legendre on each
+   of its cubic pieces, exact where E·μ is a quartic). So the Kulla–Conty lobe's own
+   normalisation 2∫(1 − Ẽ)μ dμ = 1 − E_avg holds with the Ẽ the kernel reads, and
+   the compensated albedo is 1 + E − Ẽ ≤ 1: the furnace error is the table's
+   pointwise error only, and never an excess.
 
 Public objects
 --------------
@@ -38,8 +40,14 @@ import numpy as np
 
 from brdfkit.errors import ParameterError
 from brdfkit.models._base import BRDF
-from brdfkit.pumping.table import THETA_TOP, AlbedoTable, _crossings, build_albedo_table
-from brdfkit.tables import LUT_TOL, Lookup, _as_2d, build_lookup, mu_of_w
+from brdfkit.pumping.table import (
+    THETA_TOP,
+    AlbedoTable,
+    _crossings,
+    _engine,
+    build_albedo_table,
+)
+from brdfkit.tables import LUT_TOL, Lookup, _as_2d, build_lookup, mu_of_w, theta_of_w, w_of_mu
 
 __all__ = ["E_FLOOR", "ENGINE_TOL", "TABLE_TOL", "CompensationTable", "compensation_table"]
 
@@ -55,6 +63,11 @@ ENGINE_TOL = 1e-7
 #: Smallest stored E: the lookup needs a positive function, and Turquin divides by E. An
 #: albedo this small comes only from rounding at the horizon of a sharp lobe.
 E_FLOOR = 1e-12
+#: Where the grazing piece below THETA_TOP ends (the value is held from there to the
+#: horizon): E is smooth in w but behaves like √μ at the horizon, which the kernel's lookup
+#: (cells uniform in μ) would need thousands of intervals for; held below 89.999°, a kink
+#: the lookup makes a node (docs/compensation.md, "Tables and their accuracy").
+THETA_HOLD = math.radians(89.999)
 #: Gauss–Legendre nodes on [0, 1] exact for a quartic (E·μ on one cubic piece of the lookup).
 _GL_X, _GL_W2 = np.polynomial.legendre.leggauss(3)
 _GL_T, _GL_W = 0.5 * (_GL_X + 1.0), 0.5 * _GL_W2  # mapped from [−1, 1] to [0, 1]
@@ -69,10 +82,10 @@ class CompensationTable:
     spline : AlbedoTable
         The engine's values interpolated (pumping's builder, ``margin=False``).
     lookups : tuple of Lookup
-        Per channel of E, the kernel's table of min(E, 1) (a lower bound within
-        ``lookup_error``, relative).
+        Per channel of E, the kernel's table of min(E, 1) (an upper bound within
+        ``lookup_error``, relative; read clamped at 1).
     e_avg : ndarray (C,)
-        2∫₀¹ Ẽ(μ) μ dμ of the lookup (exact for the stored cubics).
+        2∫₀¹ min(Ẽ(μ), 1) μ dμ of the lookup.
     e_avg_error : ndarray (C,)
         |E_avg of the lookup − E_avg of the spline| (Gauss–Legendre, 64 nodes per grid
         piece): how far the lookup's average is from the engine's, an estimate of
@@ -136,9 +149,9 @@ class CompensationTable:
                 + f" (+- {float(np.max(self.e_avg_error)):.2g}){clamp}")
 
     def __call__(self, mu) -> np.ndarray:
-        """Ẽ(μ) as the kernels read it: shape ``mu.shape + (C,)``."""
+        """Ẽ(μ) as the kernels read it (clamped at 1): shape ``mu.shape + (C,)``."""
         mu = np.asarray(mu, dtype=np.float64)
-        return np.concatenate([lk(mu) for lk in self.lookups], axis=-1)
+        return np.minimum(np.concatenate([lk(mu) for lk in self.lookups], axis=-1), 1.0)
 
     def to_dict(self) -> dict:
         """JSON-ready accuracy summary (the result's ``describe``)."""
@@ -150,12 +163,53 @@ class CompensationTable:
                 "message": self.message}
 
 
+def _grazing_piece(model: BRDF, spline: AlbedoTable):
+    """E on [w(THETA_HOLD), w(THETA_TOP)]: the engine's values, a cubic spline in w.
+
+    Pumping's table holds E(THETA_TOP) from 89.9° to the horizon; the compensations
+    should not: Kulla–Conty's albedo is 1 + E − Ẽ, so a held value costs E(θ) − E(89.9°)
+    beyond (8e-4 at 89.999° for GGX α = 0.5), and extending the table's first cubic cost
+    1e-5 at 89.99°. The engine integrates there too (its accuracy stays *engine_tol*):
+    8 intervals uniform in w, doubled until the midpoints meet :data:`TABLE_TOL` (at most
+    64). Returns (CubicSpline, max midpoint error (C,), engine angles).
+    """
+    from scipy.interpolate import CubicSpline
+
+    run = _engine(model, ENGINE_TOL)
+    w0, w1 = float(w_of_mu(math.cos(THETA_HOLD))), spline.s_top
+    nn, n_eval = 8, 0
+    while True:
+        nodes = np.linspace(w0, w1, nn + 1)
+        mids = 0.5 * (nodes[:-1] + nodes[1:])
+        vals = _as_2d(run(theta_of_w(nodes)))
+        ref = _as_2d(run(theta_of_w(mids)))
+        n_eval += 2 * nn + 1
+        cs = CubicSpline(nodes, vals, axis=0)
+        err = np.max(np.abs(cs(mids) - ref), axis=0)
+        if np.all(err <= TABLE_TOL) or nn >= 64:
+            return cs, err, n_eval
+        nn *= 2
+
+
+def _spline_e(spline: AlbedoTable, grazing, mu) -> np.ndarray:
+    """E at μ (T,) → (T, C): the table, the grazing piece (:func:`_grazing_piece`) below
+    THETA_TOP, held from THETA_HOLD to the horizon."""
+    mu = np.asarray(mu, dtype=np.float64)
+    out = _as_2d(spline.at_cos(mu)).copy()
+    below = mu < math.cos(THETA_TOP)
+    if np.any(below):
+        w = w_of_mu(np.maximum(mu[below], math.cos(THETA_HOLD)))  # held below THETA_HOLD
+        out[below] = _as_2d(grazing(w))
+    return out
+
+
 def _lookup_average(lk: Lookup) -> float:
-    """2∫₀¹ Ẽ(μ) μ dμ of one channel's lookup, exact for its cubic pieces.
+    """2∫₀¹ min(Ẽ(μ), 1) μ dμ of one channel's lookup, as the kernels read it.
 
     Cell j covers [j/M, (j+1)/M]; its pieces start at the anchor a₀ with spacing h
     (header), so the breakpoints are a₀ + i·h clipped to the cell; Ẽ·μ is a quartic
-    in μ on each, integrated exactly by 3-point Gauss–Legendre.
+    in μ on each, integrated exactly by 3-point Gauss–Legendre (where the clamp at 1
+    cuts a piece, within the lookup's margin ε ~ 1e-7 of it).
     """
     m = lk.n_cells
     edges = []
@@ -166,23 +220,23 @@ def _lookup_average(lk: Lookup) -> float:
     e = np.unique(np.concatenate(edges + [np.linspace(0.0, 1.0, m + 1)]))
     lo, width = e[:-1], np.diff(e)
     mu = lo[:, None] + width[:, None] * _GL_T[None, :]
-    return float(np.sum(2.0 * mu * lk(mu)[..., 0] * _GL_W[None, :] * width[:, None]))
+    e = np.minimum(lk(mu)[..., 0], 1.0)  # clamp: as the kernels read it
+    return float(np.sum(2.0 * mu * e * _GL_W[None, :] * width[:, None]))
 
 
-def _spline_average(spline: AlbedoTable) -> np.ndarray:
-    """2∫₀¹ min(E, 1) μ dμ of the spline: 64 Gauss–Legendre nodes per grid piece in w
-    (dμ = 4w(1 − w²) dw), the constant tail below THETA_TOP closed exactly."""
+def _spline_average(spline: AlbedoTable, grazing) -> np.ndarray:
+    """2∫₀¹ min(E, 1) μ dμ of the table and its grazing piece: 64 Gauss–Legendre nodes on
+    each piece in w (dμ = 4w(1 − w²) dw), the held value on [0, w(THETA_HOLD)]."""
     x, wt = np.polynomial.legendre.leggauss(64)
     total = 0.0
-    for lo, hi in zip(spline.breaks[:-1], spline.breaks[1:], strict=True):
+    edges = np.concatenate([[0.0, float(w_of_mu(math.cos(THETA_HOLD)))], spline.breaks])
+    for lo, hi in zip(edges[:-1], edges[1:], strict=True):
         w = lo + (hi - lo) * 0.5 * (x + 1.0)
         mu = mu_of_w(w)
-        e = np.minimum(_as_2d(spline.at_cos(mu)), 1.0)
+        e = np.minimum(_spline_e(spline, grazing, mu), 1.0)
         jac = 4.0 * w * (1.0 - w * w) * (hi - lo) * 0.5
         total = total + np.sum((2.0 * mu * jac * wt)[:, None] * e, axis=0)
-    mu_top = math.cos(THETA_TOP)
-    e_top = np.minimum(_as_2d(spline.at_cos(np.array([mu_top]))), 1.0)[0]
-    return total + e_top * mu_top * mu_top  # ∫₀^μtop 2μ dμ · E(THETA_TOP)
+    return total
 
 
 def compensation_table(model: BRDF, *, who: str = "compensate") -> CompensationTable:
@@ -211,25 +265,29 @@ def compensation_table(model: BRDF, *, who: str = "compensate") -> CompensationT
     t0 = time.perf_counter()
     spline = build_albedo_table(model, tol=TABLE_TOL, engine_tol=ENGINE_TOL, margin=False,
                                 who=who)
-    max_albedo = spline.max_albedo
+    grazing, grazing_err, _ = _grazing_piece(model, spline)
+    max_albedo = np.maximum(spline.max_albedo, np.max(_as_2d(grazing(grazing.x)), axis=0))
     clamped = bool(np.any(max_albedo > 1.0))
-    kinks = mu_of_w(spline.breaks[:-1])  # piece boundaries and the end at THETA_TOP
+    # the pieces' boundaries (where the grazing piece meets the table, THETA_TOP) and where
+    # the value is held (THETA_HOLD)
+    kinks = np.concatenate([mu_of_w(spline.breaks[:-1]), [math.cos(THETA_HOLD)]])
     grid = np.linspace(0.0, 1.0, 4097)
     lookups = []
     for c in range(max_albedo.size):
         def e_of(mu, c=c):
-            e = _as_2d(spline.at_cos(np.asarray(mu, dtype=np.float64)))[:, c:c + 1]
+            e = _spline_e(spline, grazing, mu)[:, c:c + 1]
             return np.clip(e, E_FLOOR, 1.0)  # clamp: see E_FLOOR and the docstring (E > 1)
         ks = kinks
         if clamped:  # where E crosses 1, the clamp makes a kink
-            ks = np.concatenate([ks, _crossings(lambda m, c=c: _as_2d(
-                spline.at_cos(m))[:, c:c + 1] - 1.0, grid, _as_2d(spline.at_cos(grid))[
-                    :, c:c + 1] - 1.0)])
-        lookups.append(build_lookup(e_of, kinks=ks, tol=LUT_TOL, bound="lower"))
+            ks = np.concatenate([ks, _crossings(lambda m, c=c: _spline_e(
+                spline, grazing, m)[:, c:c + 1] - 1.0, grid, _spline_e(
+                spline, grazing, grid)[:, c:c + 1] - 1.0)])
+        lookups.append(build_lookup(e_of, kinks=ks, tol=LUT_TOL, bound="upper"))
     e_avg = np.array([_lookup_average(lk) for lk in lookups])
-    e_avg_error = np.abs(e_avg - _spline_average(spline))
+    e_avg_error = np.abs(e_avg - _spline_average(spline, grazing))
     return CompensationTable(
         spline=spline, lookups=tuple(lookups), e_avg=e_avg, e_avg_error=e_avg_error,
-        max_albedo=max_albedo, clamped=clamped, interp_error=spline.max_midpoint_error,
+        max_albedo=max_albedo, clamped=clamped,
+        interp_error=np.maximum(spline.max_midpoint_error, grazing_err),
         lookup_error=float(max(lk.max_error + lk.epsilon for lk in lookups)),
         engine_tol=ENGINE_TOL, seconds=time.perf_counter() - t0)

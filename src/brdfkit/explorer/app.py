@@ -114,14 +114,15 @@ def parse_state(state: dict) -> dict:
 
 def entry_spec(entry: dict) -> ModelSpec:
     """The :class:`~brdfkit.spec.ModelSpec` of one state entry ``{"spec", "params",
-    "pump", "times"}``: the spec's flat dict form with the page's conventions — the
-    name under ``spec``, empty fields dropped, ``beta`` in degrees (as on the command
-    line)."""
+    "compensate", "pump", "times"}``: the spec's flat dict form with the page's
+    conventions — the name under ``spec``, empty fields dropped, ``beta`` in degrees (as
+    on the command line)."""
     params = _page_params(entry)
     if "beta" in params:  # degrees in the UI, as on the command line
         params["beta"] = math.radians(float(params["beta"]))
     return ModelSpec.from_dict({"model": entry["spec"], "params": params,
-                                **{k: entry[k] for k in ("pump", "times") if k in entry}})
+                                **{k: entry[k] for k in ("compensate", "pump", "times")
+                                   if k in entry}})
 
 
 def _page_params(entry: dict) -> dict:

@@ -53,6 +53,8 @@ def hold_scale(prob, values: dict, coords: list, linear) -> list:
         return []
     half = dict(values)
     for n in linear:
+        if values[n] is None:
+            continue  # an optional colour parameter not given (a microfacet's eta: F = 1)
         half[n] = np.asarray(values[n], dtype=np.float64) * 0.5 \
             if np.ndim(values[n]) else 0.5 * float(values[n])
     _, p1 = prob.predict(values)

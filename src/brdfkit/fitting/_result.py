@@ -102,7 +102,7 @@ class FitResult:
             albedo["target_error"] = self.albedo_target_error.tolist()
         conv = self.convergence
         return {"model": d["model"], "params": d["params"],
-                **({"pump": d["pump"]} if "pump" in d else {}),
+                **{k: d[k] for k in ("compensate", "pump") if k in d},
                 "loss": self.loss, "value": self.value, "metrics": dict(self.metrics),
                 "albedo": albedo,
                 "convergence": conv.to_dict() if isinstance(conv, Convergence) else conv,
