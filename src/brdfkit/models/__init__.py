@@ -5,7 +5,8 @@ Reflectance models
 One module per family; every model is registered in :data:`MODELS`.
 
 - :mod:`~brdfkit.models.diffuse` — Lambert, Neumann–Neumann, Minnaert.
-- :mod:`~brdfkit.models.rough_diffuse` — Oren–Nayar (full, qualitative), FON, EON.
+- :mod:`~brdfkit.models.rough_diffuse` — Oren–Nayar (full, qualitative), FON;
+  :mod:`~brdfkit.models.eon` — EON and its clipped-LTC sampler.
 - :mod:`~brdfkit.models.phong` — normalised Phong and Lewis's Phong, Blinn and
   energy-conserving shaders (R·V lobes, and N·H divided by N·L).
 - :mod:`~brdfkit.models.blinn` — reciprocal N·H lobes: Lewis's reciprocal
@@ -35,7 +36,7 @@ from brdfkit.models._registry import MODELS, model, model_names, register, resol
 # `brdfkit models`, of the README's model table and of Table 2.
 # isort: off
 from brdfkit.models import diffuse, phong, blinn, lafortune, grazing  # noqa: E402,F401,I001
-from brdfkit.models import rough_diffuse  # noqa: E402,F401,I001
+from brdfkit.models import rough_diffuse, eon  # noqa: E402,F401,I001
 from brdfkit.models import microfacet, vgroove, ward, he_torrance  # noqa: E402,F401,I001
 from brdfkit.models import microfacet_anisotropic, ashikhmin_shirley  # noqa: E402,F401,I001
 from brdfkit.models import disney  # noqa: E402,F401,I001

@@ -14,12 +14,13 @@ Public objects
 - :class:`OrenNayar` — ``oren-nayar``: the full model (C₁, C₂, C₃ and the
   interreflection term L²) or the qualitative one, a choice.
 - :class:`FON` — ``fon``: ρ/π · A (1 + r s/t).
-- :class:`EON` — ``eon``: f_FON + f_ms, energy-preserving for white ρ.
+- EON (``eon``: f_FON + f_ms, energy-preserving for white ρ) and its clipped-LTC
+  sampler are :mod:`brdfkit.models.eon`, built on the FON formulas here.
 - :func:`fon_albedo`, :func:`fon_average_albedo` — E_FON(μ) (exact or the
   paper's polynomial) and Ē_FON, in NumPy.
 - :func:`oren_nayar_full`, :func:`oren_nayar_qualitative`, :func:`fon`,
-  :func:`eon`, :func:`cosine_sample`, :func:`cosine_pdf` — the formulas
-  (:mod:`brdfkit._dual`): compiled kernels here, traced in Mitsuba.
+  :func:`g_exact`, :func:`g_approx`, :func:`cosine_sample`, :func:`cosine_pdf` — the
+  formulas (:mod:`brdfkit._dual`): compiled kernels here, traced in Mitsuba.
 
 Derivations (checked in ``tests/test_rough_diffuse.py``)
 --------------------------------------------------------
@@ -59,24 +60,23 @@ name        default  bounds          meaning
 rho         0.8      [0, 1]          facet albedo (per channel); ``oren-nayar``,
                                      ``fon``, ``eon``
 sigma       0.3      [0, π/2] rad    ``oren-nayar``: standard deviation of the
-                                     facet slope angle; 0 is Lambert, 0.1–0.3
-                                     (6–17°) matte paint, 0.4–0.6 plaster, clay,
-                                     sand; ``form=full`` needs ≤ 0.66 (above)
+                                     facet slope angle; 0 is Lambert, 0.1–0.2
+                                     (6–11°) slightly rough, 0.3–0.6 (17–34°)
+                                     visibly flat, retro-reflective (clay,
+                                     plaster); ``form=full`` needs ≤ 0.66 (above)
 form        full     full|qualit.    ``oren-nayar``: the full model or the
                                      qualitative A + B max(0, cos) sin α tan β
 r           0.5      [0, 1]          ``fon``, ``eon``: roughness as the EON paper
                                      names it (0 Lambert, 1 roughest; r > 1 would
                                      make 1 + r s/t negative)
 E_FON       exact    exact|approx    ``eon``: FON's albedo in closed form or the
-                                     paper's quartic in 1 − μ (faster, a ≠ 1 by
-                                     ≤ 1e-3)
+                                     paper's quartic in 1 − μ (faster; for ρ = 1,
+                                     |1 − a| ≤ 5.3e-4 measured)
 ==========  =======  ==============  =============================================
 
-Sampling: cosine (cos θ_i/π, the weight is π f). EON's paper also gives a
-clipped-LTC sampler; it is not implemented here: it rests on the authors'
-fitted LTC coefficients (their listing's ``ltc_terms`` and the uniform-lobe
-weight), which would be a transcription of their code, and the cosine is
-unbiased with a weight π f that is bounded away from joint grazing.
+Sampling: cosine for ``oren-nayar`` and ``fon`` (cos θ_i/π, the weight is π f);
+``eon`` by the paper's clipped linearly transformed cosine mixed with a uniform
+lobe (:mod:`brdfkit.models.eon`).
 
 References
 ----------
@@ -124,8 +124,9 @@ from brdfkit.models._drivers import loop_driver
 from brdfkit.models._params import packed_indices
 from brdfkit.models._registry import register
 
-__all__ = ["OrenNayar", "FON", "EON", "fon_albedo", "fon_average_albedo", "oren_nayar_full",
-           "oren_nayar_qualitative", "fon", "eon", "cosine_sample", "cosine_pdf"]
+__all__ = ["OrenNayar", "FON", "fon_albedo", "fon_average_albedo", "oren_nayar_full",
+           "oren_nayar_qualitative", "fon", "g_exact", "g_approx", "cosine_sample",
+           "cosine_pdf", "FON_PARAMS", "C1_FON", "C2_FON"]
 
 INV_PI = 1.0 / math.pi
 TWO_PI = 2.0 * math.pi
@@ -148,8 +149,8 @@ SIGMA_FULL_MAX = 0.66
 ON_PARAMS = (
     Param("rho", 0.8, 0.0, 1.0, "", "albedo of the Lambertian facets", kind="colour"),
     Param("sigma", 0.3, 0.0, 0.5 * math.pi, "rad",
-          "standard deviation of the facet slope angle: 0 Lambert, 0.1-0.3 matte, 0.4-0.6 "
-          "plaster or sand (form=full needs <= 0.66, where it stays >= 0)"),
+          "standard deviation of the facet slope angle: 0 Lambert, 0.1-0.2 slightly rough, "
+          "0.3-0.6 flat and retro-reflective (form=full needs <= 0.66, where it stays >= 0)"),
     Param("form", "full", kind="choice", choices=("full", "qualitative"),
           doc="full: C1, C2, C3 and the interreflection term; qualitative: A + B max(0, cos) "
               "sin(alpha) tan(beta)"),
@@ -253,9 +254,10 @@ def cosine_pdf(ix, iy, iz, ox, oy, oz):
     return select(oz > 0.0, maximum(iz, 0.0) * INV_PI, 0.0)
 
 
-class _CosineSampled:
-    """Cosine sampling (``BRDF.sample``/``pdf``, exact for the diffuse lobe's cosine) and
-    the formulas of this instance's kernel (``_formula``) for the Mitsuba bridge."""
+class _RoughDiffuse:
+    """What the rough diffuse models share: one diffuse lobe, the N·V = N·L kink circle,
+    cosine sampling (``BRDF.sample``/``pdf``; the weight is π f) and the formulas of this
+    instance's kernel (``_formula``, set by ``_validate``) for the Mitsuba bridge."""
 
     has_sampler = True
 
@@ -274,7 +276,7 @@ class _CosineSampled:
 
 
 @register
-class OrenNayar(_CosineSampled, BRDF):
+class OrenNayar(_RoughDiffuse, BRDF):
     """Oren & Nayar (1994): Lambertian V-cavities with Gaussian slope angles, std σ.
 
     ``form="full"``: the functional approximation with C₁, C₂, C₃ and the
@@ -292,11 +294,13 @@ class OrenNayar(_CosineSampled, BRDF):
     form    full     full/qualitative  which of the paper's two forms
     ======  =======  ================  ============================================
 
-    Reciprocal (both forms: symmetric in α, β and cos Δφ). Not energy-conserving:
-    masking and shadowing lose energy that the qualitative form does not return
-    (its white furnace a < 1 at every angle for σ > 0, measured in the tests), and
-    the full form's L_r² adds back only part of it. Both diverge as both directions
-    approach the horizon (tan β), with a finite albedo. Sampled by the cosine.
+    Reciprocal (both forms: symmetric in α, β and cos Δφ). Not energy-conserving,
+    either way (white ρ = 1, measured in the tests): the qualitative form loses up to
+    44 % at normal incidence (1 − a(0°) = 1 − A: 0.22 at σ = 0.5, 0.44 at σ = π/2) but
+    for small σ its B sin α tan β term returns more than 1 at grazing (a(89°) = 1.012
+    at σ = 0.25); the full form's L_r² adds more (a(89°) = 1.043 at σ = 0.25). Both
+    diverge as both directions approach the horizon (tan β), with a finite albedo.
+    Sampled by the cosine.
     """
 
     name = "oren-nayar"
@@ -324,19 +328,12 @@ class OrenNayar(_CosineSampled, BRDF):
         self._driver = loop_driver(self._formula, loop="vector")
 
 
-# =========================================================================== FON and EON
+# =========================================================================== FON
 FON_PARAMS = (
     Param("rho", 0.8, 0.0, 1.0, "", "single-scattering albedo", kind="colour"),
     Param("r", 0.5, 0.0, 1.0, "", "roughness: 0 Lambert, 1 roughest (EON's symbol)"),
 )
 P_F_RHO, P_F_R = packed_indices(FON_PARAMS, "rho", "r")
-EON_PARAMS = FON_PARAMS + (
-    Param("E_FON", "exact", kind="choice", choices=("exact", "approx"),
-          doc="FON's albedo in the multiple-scattering lobe: exact closed form (a = 1 for "
-              "rho = 1) or the paper's quartic in 1 - mu"),
-)
-(P_E_FON,) = packed_indices(EON_PARAMS, "E_FON")
-EXACT, APPROX = 0, 1  # the packed value of the E_FON choice
 
 
 @formula
@@ -370,59 +367,13 @@ def g_approx(mu):
     return x * (G1 + x * (G2 + x * (G3 + x * G4)))
 
 
-@formula
-def eon(ix, iy, iz, ox, oy, oz, p, exact):
-    """EON: f_FON + f_ms (EON §4, Listing 1), a formula; *exact* a compile-time flag.
-
-    f_ms = (ρ_ms/π)(1 − E_FON(μ_i))(1 − E_FON(μ_o))/(1 − Ē_FON), written with
-    1 − E = A r (c₁ − G/π) (module docstring), ρ_ms = ρ² Ē/(1 − ρ(1 − Ē)).
-    """
-    rho, r = p[P_F_RHO], p[P_F_R]
-    live = (iz > 0.0) & (oz > 0.0)
-    mu_i = maximum(iz, 0.0)  # clamp: the discarded lanes below the horizon stay finite
-    mu_o = maximum(oz, 0.0)
-    if exact:
-        gi = g_exact(ix, iy, mu_i)
-        go = g_exact(ox, oy, mu_o)
-    else:
-        gi = g_approx(mu_i)
-        go = g_approx(mu_o)
-    a = 1.0 / (1.0 + C1_FON * r)
-    e_avg = a * (1.0 + C2_FON * r)
-    rho_ms = rho * rho * e_avg / (1.0 - rho * (1.0 - e_avg))
-    # clamp at 0: the quartic exceeds c₁ by up to 3.2e-4 within ~3° of the horizon (E > 1),
-    # where f_ms would turn negative (the authors' listing floors 1 − E at 1e-7 likewise)
-    di = maximum(C1_FON - gi, 0.0)
-    do = maximum(C1_FON - go, 0.0)
-    f_ms = rho_ms * INV_PI * a * r * di * do / (C1_FON - C2_FON)
-    return select(live, fon(ix, iy, iz, ox, oy, oz, p) + f_ms, 0.0)
-
-
 @formula(**VECTOR_OPTIONS)
 def _fon(ix, iy, iz, ox, oy, oz, p):
     return fon(ix, iy, iz, ox, oy, oz, p)
 
 
-@formula(**VECTOR_OPTIONS)
-def _eon_exact(ix, iy, iz, ox, oy, oz, p):
-    return eon(ix, iy, iz, ox, oy, oz, p, True)
-
-
-@formula(**VECTOR_OPTIONS)
-def _eon_approx(ix, iy, iz, ox, oy, oz, p):
-    return eon(ix, iy, iz, ox, oy, oz, p, False)
-
-
-@numba.njit(cache=True, **VECTOR_OPTIONS)
-def _eon(ix, iy, iz, ox, oy, oz, p):
-    """The model's kernel for callers with one kernel per model: dispatches on E_FON."""
-    if p[P_E_FON] == APPROX:
-        return _eon_approx(ix, iy, iz, ox, oy, oz, p)
-    return _eon_exact(ix, iy, iz, ox, oy, oz, p)
-
-
 @register
-class FON(_CosineSampled, BRDF):
+class FON(_RoughDiffuse, BRDF):
     """Fujii's improved Oren–Nayar (FON), as the EON paper writes it (§3).
 
     f = ρ/π · A (1 + r s/t), s = ω_i·ω_o − μ_iμ_o, t = max(μ_i, μ_o) for s > 0 else 1,
@@ -448,57 +399,14 @@ class FON(_CosineSampled, BRDF):
     citation = "Portsmouth, Kutz, Hill 2025 (EON) §3, Listing 1 (after Fujii's improved Oren-Nayar)"
     reciprocal = True
     kernel = _fon
-    _formula = _fon
     examples = (
         {},
         {"r": 1.0, "rho": [0.2, 0.5, 1.0]},
     )
 
     def _validate(self):
+        self._formula = _fon  # per instance: a dispatcher class attribute would bind as a method
         self._driver = loop_driver(_fon, loop="vector")
-
-
-@register
-class EON(_CosineSampled, BRDF):
-    """EON (Portsmouth, Kutz, Hill 2025): FON plus its energy compensation.
-
-    f = f_FON + (ρ_ms/π)(1 − E_FON(μ_i))(1 − E_FON(μ_o))/(1 − Ē_FON),
-    ρ_ms = ρ² Ē_FON/(1 − ρ(1 − Ē_FON)) (EON §4, Listing 1; OpenPBR's diffuse).
-
-    =====  =======  ============  ===============================================
-    name   default  bounds        meaning
-    =====  =======  ============  ===============================================
-    rho    0.8      [0, 1]        albedo (per channel)
-    r      0.5      [0, 1]        roughness; 0 is Lambert
-    E_FON  exact    exact/approx  FON's albedo in f_ms: the closed form (a = 1 for
-                                  ρ = 1 to the engine's accuracy) or the paper's
-                                  quartic (cheaper; a = 1 to ~1e-3)
-    =====  =======  ============  ===============================================
-
-    Reciprocal. Energy-preserving: for ρ = 1 the albedo is 1 at every angle with
-    ``E_FON="exact"`` (module docstring; measured in the tests); for ρ < 1 its
-    albedo is ρ E_FON + ρ_ms (1 − E_FON), the paper's multiple-scattering
-    estimate. Sampled by the cosine (not the paper's clipped-LTC sampler: module
-    docstring).
-    """
-
-    name = "eon"
-    aliases = ("energy-preserving-oren-nayar", "openpbr-diffuse")
-    summary = "EON energy-preserving Oren-Nayar: FON + (1-E(mu_i))(1-E(mu_o)) lobe"
-    params = EON_PARAMS
-    citation = ("Portsmouth, Kutz, Hill 2025 (JCGT 14(1)) §§3-4, Listing 1: f_FON + f_ms, "
-                "E_FON exact or approx")
-    reciprocal = True
-    kernel = _eon
-    examples = (
-        {},
-        {"r": 1.0, "rho": 1.0},
-        {"r": 0.3, "rho": [0.2, 0.5, 0.9], "E_FON": "approx"},
-    )
-
-    def _validate(self):
-        self._formula = _eon_approx if self._values["E_FON"] == "approx" else _eon_exact
-        self._driver = loop_driver(self._formula, loop="vector")
 
 
 # =========================================================================== NumPy closed forms
