@@ -16,9 +16,9 @@ isotropic ones to rounding (``tests/test_microfacet_anisotropic.py``).
 With q(h) = (h_x/α_x)² + (h_y/α_y)² (so q/h_z² = tan²θ_h (cos²φ_h/α_x² + sin²φ_h/α_y²)):
 
 - D_GGX(h) = 1/(π α_x α_y (h_z² + q)²) and D_Beckmann(h) = e^{−q/h_z²}/(π α_x α_y h_z⁴)
-  (Heitz 2014, eqs. 84 and 85 in slope form);
+  (Heitz 2014 §5.3: the isotropic D of the slopes stretched by α_x, α_y);
 - Smith Λ and G₁ = 1/(1 + Λ) of the isotropic distributions with the projected
-  roughness α(ω) = √(cos²φ α_x² + sin²φ α_y²) (Heitz 2014 §5.3, eq. 86):
+  roughness α(ω) = √(cos²φ α_x² + sin²φ α_y²) (Heitz 2014 §5.3):
   α(ω)² tan²θ = (α_x² ω_x² + α_y² ω_y²)/ω_z²;
 - the sampler of D(h) cos θ_h: φ_h the direction of (α_x cos 2πu₁, α_y sin 2πu₁), i.e.
   tan φ_h = (α_y/α_x) tan 2πu₁ in the right quadrant, and tan²θ_h the isotropic one with
@@ -37,7 +37,8 @@ Public objects
 References
 ----------
 - [Heitz2014] E. Heitz, *Understanding the Masking-Shadowing Function in
-  Microfacet-Based BRDFs*, JCGT 3(2), 2014, §5.3 and eqs. (84)-(86).
+  Microfacet-Based BRDFs*, JCGT 3(2), 2014, §5.3 (anisotropic distributions by stretching; equation
+  numbers not cited: the paper is not on this machine).
 - [Walter2007] eqs. (25)-(28), (33)-(35) (the isotropic distributions).
 """
 
@@ -71,7 +72,7 @@ def q_of(x, y, ax, ay):
 
 @formula
 def r2_of(x, y, ax, ay):
-    """α(ω)² sin²θ = α_x² ω_x² + α_y² ω_y² of a unit direction ω (Heitz 2014 eq. 86)."""
+    """α(ω)² sin²θ = α_x² ω_x² + α_y² ω_y² of a unit direction ω (Heitz 2014 §5.3)."""
     x = x * ax
     y = y * ay
     return x * x + y * y
@@ -179,7 +180,7 @@ class AnisotropicGGX(_Anisotropic):
     _d, _half = _d_ggx, _half_ggx
 
     def lambda_(self, w: np.ndarray) -> np.ndarray:
-        """Λ = (√(1 + 1/a²) − 1)/2 (Heitz 2014 eq. 86 with the GGX Λ)."""
+        """Λ = (√(1 + 1/a²) − 1)/2 (Heitz 2014 §5.3 with the GGX Λ)."""
         with np.errstate(divide="ignore"):
             return 0.5 * (np.sqrt(1.0 + 1.0 / self.a(w) ** 2) - 1.0)
 

@@ -208,8 +208,8 @@ def as_sample(ox, oy, oz, u0, u1, nu, nv, w_d):
     cz = sqrt(maximum(1.0 - uc, 0.0))  # clamp: rounding at the rim
     hx, hy, hz = as_half(us, u1, nu, nv)
     c = 2.0 * (ox * hx + oy * hy + oz * hz)
-    return (select(pick_cos, r * cos(phi), c * hx - ox), select(pick_cos, r * sin(phi), c * hy - oy),
-            select(pick_cos, cz, c * hz - oz))
+    return (select(pick_cos, r * cos(phi), c * hx - ox),
+            select(pick_cos, r * sin(phi), c * hy - oy), select(pick_cos, cz, c * hz - oz))
 
 
 @formula
@@ -245,10 +245,11 @@ class AshikhminShirley(StrategySampled, BRDF):
     """Ashikhmin & Shirley (2000) anisotropic Phong BRDF, eqs. (4) + (5) (module docstring).
 
     Reciprocal (both terms are symmetric in ω_i, ω_o); not isotropic for n_u ≠ n_v.
-    Energy: the paper bounds the albedo by 1 for R_s, R_d ≤ 1 (the specular lobe's
-    albedo ≤ F, the diffuse term scaled by 1 − R_s); measured with the albedo engine in
-    ``tests/test_ashikhmin_shirley.py``. Sampled by the paper's half-vector sampler (§3)
-    mixed with the cosine for the diffuse term.
+    Energy: the paper claims conservation (albedo ≤ 1 for R_s, R_d ≤ 1: the specular
+    lobe normalised by max(μ_i, μ_o), the diffuse term scaled by 1 − R_s); measured with
+    the albedo engine in ``tests/test_ashikhmin_shirley.py``: max 0.9960 (R_s = 1,
+    n_u = n_v = 1000, θ_i = 0), 31/32 + the Schlick tail at R_s = 0. Sampled by the
+    paper's half-vector sampler (§3) mixed with the cosine for the diffuse term.
     """
 
     name = "ashikhmin-shirley"
@@ -260,6 +261,11 @@ class AshikhminShirley(StrategySampled, BRDF):
     isotropic = False
     has_sampler = True
     kernel = ashikhmin_shirley
+    # The specular denominator's max(μ_i, μ_o) kinks ω_o ↦ f on N·V = N·L; declared as
+    # albedo_kinks {"nv=nl"} it changed no error estimate of the albedo engine (θ_i 30-89.9°,
+    # φ_i = 45°, n = 10/1000 and 10/10) and cost up to twice the time: left to refinement.
+    # At grazing incidence the lobe peaks as 1/((k·h) μ_i) near the horizon, where the
+    # engine may stop at its refinement limit (status and error estimate say so).
     examples = (
         {},
         {"n_u": 1000.0, "n_v": 10.0, "R_s": [0.9, 0.6, 0.3], "R_d": [0.1, 0.2, 0.3]},

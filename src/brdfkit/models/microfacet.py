@@ -14,7 +14,10 @@ Public objects
   separable Smith masking, conductor Fresnel; its kernel is branch-free and
   runs in the vectorised loop (:func:`~brdfkit.models._drivers.loop_driver`,
   ``loop="vector"``).
-- :func:`walter`, :func:`walter_sample`, :func:`walter_pdf` — its formulas.
+- :func:`walter`, :func:`walter_sample`, :func:`walter_pdf` — its formulas;
+  :func:`half_sum`, :func:`cos_d_of`, :func:`reflection_jacobian` — their first steps,
+  shared with :mod:`~brdfkit.models.microfacet_anisotropic` and
+  :mod:`~brdfkit.models.ashikhmin_shirley`.
 - Re-exported for existing callers: the distribution functions
   (:func:`d_beckmann`, :func:`d_ggx`, :func:`beckmann_g1_of_a`,
   :func:`smith_g1_beckmann`, :func:`ggx_g1_over_cos`, …).

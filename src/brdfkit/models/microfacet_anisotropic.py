@@ -5,7 +5,7 @@ The anisotropic Walter et al. (2007) microfacet model
 Walter's eq. (20) with the anisotropic GGX or Beckmann distribution of
 :mod:`brdfkit.models.anisotropic_distributions` (α_x along brdfkit's tangent X = +x,
 α_y along the bitangent Y = +y) and the Smith G₁ of the projected roughness
-α(ω) = √(cos²φ α_x² + sin²φ α_y²) (Heitz 2014 eq. 86): the model of Mitsuba 3's
+α(ω) = √(cos²φ α_x² + sin²φ α_y²) (Heitz 2014 §5.3): the model of Mitsuba 3's
 ``roughconductor`` with ``alpha_u``/``alpha_v`` and of pbrt-v4's ``conductor`` with
 ``uroughness``/``vroughness``. At α_x = α_y it is :class:`~brdfkit.models.microfacet.Microfacet`
 to rounding.
@@ -43,7 +43,8 @@ References
 ----------
 - [Walter2007] eq. (20) (BRDF), (25)-(28) Beckmann, (33)-(35) GGX.
 - [Heitz2014] E. Heitz, *Understanding the Masking-Shadowing Function in
-  Microfacet-Based BRDFs*, JCGT 3(2), 2014, eqs. (84)-(86), §5.3.
+  Microfacet-Based BRDFs*, JCGT 3(2), 2014, §5.3 (anisotropic distributions by stretching; equation
+  numbers not cited: the paper is not on this machine).
 """
 
 from __future__ import annotations
@@ -58,7 +59,7 @@ from brdfkit.errors import ParameterError
 from brdfkit.fresnel import _fresnel_conductor
 from brdfkit.models._base import BRDF, VECTOR_OPTIONS, Lobe, Param
 from brdfkit.models._drivers import loop_driver
-from brdfkit.models._params import ETA, packed_indices
+from brdfkit.models._params import ETA, eta_fresnel_split, packed_indices
 from brdfkit.models._registry import register
 from brdfkit.models.anisotropic_distributions import (
     anisotropic_distribution,
@@ -220,7 +221,7 @@ class MicrofacetAnisotropic(StrategySampled, BRDF):
     summary = "anisotropic Walter 2007 microfacet BRDF (Beckmann/GGX with alpha_x, alpha_y)"
     params = PARAMS
     citation = ("Walter et al. 2007 eq. (20) with (25)-(27)/(33)-(34) made anisotropic; "
-                "Heitz 2014 eqs. (84)-(86)")
+                "Heitz 2014 §5.3")
     reciprocal = True
     isotropic = False
     has_sampler = True
@@ -248,6 +249,11 @@ class MicrofacetAnisotropic(StrategySampled, BRDF):
     def lobes(self):
         # the narrower axis sets the resolution; a half-vector lobe (D of h)
         return [Lobe("half", float(min(self._values["alpha_x"], self._values["alpha_y"])))]
+
+    def fresnel_split(self):
+        """F = ρ_s · F_conductor(η, κ) (1 without η); white: η not given, κ = 0, ρ_s = 1 (as
+        :meth:`~brdfkit.models.microfacet.Microfacet.fresnel_split`)."""
+        return eta_fresnel_split(self, k="k", scale="rho_s")
 
     def _strategy(self, wo):
         v = self._values

@@ -25,7 +25,10 @@ Formulas (:mod:`brdfkit._dual`: compiled by Numba, traced by Dr.Jit in the Mitsu
     :func:`d_ggx_of_h`, :func:`ggx_g1_over_cos`, :func:`beckmann_dg_over_cos`,
     :func:`d_of_h` and :func:`sample_half` (the D cos θ_h sampler of both
     distributions and its D); the Beckmann h(a) is a primitive (table for
-    Numba, ``erf`` for Dr.Jit).
+    Numba, ``erf`` for Dr.Jit). The forms the anisotropic distributions
+    (:mod:`brdfkit.models.anisotropic_distributions`) share with these:
+    :func:`d_ggx_of_u`, :func:`d_beckmann_of_t`, :func:`beckmann_dg_core`,
+    :func:`ggx_g1_over_cos_r2`, :func:`_beckmann_g1_over_cos_r`, :func:`tan2_half`.
 Phong lobe (Lewis's D₁, a sampling proposal)
     :class:`~brdfkit.models.sampling.PowerHalf` (the "phong" distribution).
 
@@ -312,7 +315,7 @@ def d_ggx_of_h(hz2: float, hxy2: float, inv_a2: float, alpha: float) -> float:
 def d_ggx_of_u(u: float, a2: float) -> float:
     """GGX D = 1/(π a2 u²) from u = h_z² + |h_xy|²/α² (isotropic, a2 = α²) or
     h_z² + (h_x/α_x)² + (h_y/α_y)² (anisotropic, a2 = α_x α_y): Walter eq. (33) and its
-    anisotropic form (Heitz 2014 eq. 85) multiplied out."""
+    anisotropic form (Heitz 2014 §5.3) multiplied out."""
     return 1.0 / (PI * a2 * (u * u))
 
 
