@@ -94,13 +94,15 @@ def _compensated(rows: dict, method: str) -> tuple[list[dict], float, float, tup
 
 
 def _beyond(rs: list[dict]) -> str:
-    """What check's grid sees beyond the furnace angles (to 89.999°): the largest albedo."""
+    """What check's grid (to 89.999°, beyond the furnace angles) says of the rows' energy."""
     top = max(rs, key=lambda r: r["max_albedo"])
-    if top["max_albedo"] <= 1.0 + top["max_albedo_error"]:
-        return "; a <= 1 on check's whole grid (to 89.999 deg) in every row"
-    return (f"; beyond 89 deg check's grid finds a > 1: max a = {top['max_albedo']:.5f} ± "
-            f"{top['max_albedo_error']:.0e} at {top['theta_max_deg']:g} deg ({top['label']}; "
-            f"{sum(r['energy'] == 'exceeds' for r in rs)} of {len(rs)} rows exceed 1 there)")
+    where = f"max a = {top['max_albedo']:.7f} ± {top['max_albedo_error']:.0e} at " \
+            f"{top['theta_max_deg']:g} deg ({top['label']})"
+    over = [r for r in rs if r["energy"] != "conserves"]
+    if not over:
+        return f"; on check's whole grid (to 89.999 deg) every row conserves: {where}"
+    return (f"; on check's grid (to 89.999 deg) {len(over)} of {len(rs)} rows do not conserve "
+            f"({', '.join(sorted({r['energy'] for r in over}))}): {where}")
 
 
 def _kulla_conty(rows: dict) -> tuple[str, str]:
