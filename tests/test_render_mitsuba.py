@@ -302,13 +302,17 @@ class _Swapped:
         return self.model.eval(wo, wi)
 
 
-@pytest.mark.parametrize("pumped", [False, True], ids=["phong", "pumped-phong"])
+@pytest.mark.parametrize("pumped", [False, True, "kulla-conty"],
+                         ids=["phong", "pumped-phong", "compensated-phong"])
 def test_white_furnace(pumped):
-    """Uniform sky only (L_a = 1, E = 0): every pixel shows the albedo at its view angle."""
+    """Uniform sky only (L_a = 1, E = 0): every pixel shows the albedo at its view angle
+    (the Kulla–Conty compensated Phong, its own white form: 1 everywhere)."""
     variant = _variant("llvm_ad_rgb")
     size, spp, k = _budget(variant)
     model = brdfkit.model("modified-phong", rho_d=0.2, rho_s=0.5, n=20.0)
-    if pumped:
+    if pumped == "kulla-conty":
+        model = brdfkit.compensate(model, "kulla-conty")
+    elif pumped:
         model = pump(model, g="max")
     imgs = renders(model, variant=variant, size=size, spp=spp, k=k, irradiance=0.0,
                    ambient=1.0, seed0=100)
