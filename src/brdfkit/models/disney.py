@@ -68,9 +68,9 @@ products of one factor per direction with the symmetric F_D90(cos θ_d), f_ss de
 cos θ_l + cos θ_v, D and F_H on h, G on one factor per direction — although Burley does
 not claim it (the notes aim for plausibility, not a proof). **Isotropic** only when
 anisotropic = 0 (per instance). **Energy**: not claimed (nor by Burley): the diffuse
-retro-reflection and the subsurface term exceed a Lambertian's albedo at grazing
-incidence on rough surfaces (``tests/test_disney.py`` measures it), and single-scattering
-GGX loses energy at high roughness.
+retro-reflection exceeds a Lambertian's albedo (white, roughness 1: 1 + 1/28 at normal
+incidence, 1.52 at 89°, ``tests/test_disney.py``), so does the subsurface term at grazing
+incidence, and single-scattering GGX loses energy at high roughness.
 
 Guidance: keep base_color a display colour (it is linearised); roughness 0.3–0.6 for
 most dielectrics; metallic 0 or 1 (intermediate values blend); use anisotropic with a
@@ -148,8 +148,7 @@ HK_SUM_FLOOR = 1e-300
 ALPHA_FLOOR = 0.001
 #: The luminance weights of disney.brdf's tint (its "luminance approx."), not Rec. 709's.
 TINT_LUMINANCE = (0.3, 0.6, 0.1)
-#: mon2lin: the display base colour to linear, C^2.2 (disney.brdf).
-GAMMA = 2.2
+GAMMA = 2.2  # mon2lin: the display base colour to linear, C^2.2 (disney.brdf)
 #: Smith GGX α of the clearcoat's G_r (disney.brdf: 0.25), squared: α² = 0.0625.
 COAT_G_A2 = 0.0625
 #: 1/21 = ∫₀¹ (1 − μ)⁵ 2μ dμ, the cosine-weighted hemispherical mean of Schlick's weight:
@@ -280,10 +279,12 @@ def principled_channel(kd, ksh, cs0, live, diffuse, f_h, gd_s, coat):
 
 @formula
 def principled(ix, iy, iz, ox, oy, oz, p):
-    """f_r of disney.brdf (module docstring) for one channel's packed row *p*: one basic
-    block (branch-free, total), so that the driver vectorises it."""
-    live, diffuse, f_h, gd_s, coat = principled_terms(ix, iy, iz, ox, oy, oz, p)
-    return principled_channel(p[P_KD], p[P_KSH], p[P_CS0], live, diffuse, f_h, gd_s, coat)
+    """f_r of disney.brdf (module docstring) for one channel's packed row *p* (N_PACKED
+    values): one basic block (branch-free, total), so that the driver vectorises it."""
+    # the row read first as a tuple: loads spread through the terms kept LLVM from vectorising
+    q = (p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9], p[10], p[11])
+    live, diffuse, f_h, gd_s, coat = principled_terms(ix, iy, iz, ox, oy, oz, q)
+    return principled_channel(q[P_KD], q[P_KSH], q[P_CS0], live, diffuse, f_h, gd_s, coat)
 
 
 @formula(**VECTOR_OPTIONS)
