@@ -9,7 +9,8 @@ The energy verdicts command: ``verdicts``
   (:mod:`brdfkit.report.energy_findings`) with their numbers.
 
 Like ``table2``: progress on stderr when it is a terminal (never in ``--json`` output);
-``--json`` prints ``{"rows": [...], "findings": [...]}``. A plain click command;
+``--json`` prints ``{"rows": [...], "findings": [...]}`` (strict JSON: an infinite error
+estimate, where the engine did not converge, is null). A plain click command;
 :mod:`brdfkit.cli` adds it to the group.
 """
 
