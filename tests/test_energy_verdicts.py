@@ -14,6 +14,13 @@ References (none is the program's own output):
   φ_o) — a second method — and E(1) = 1 − ln 2 in closed form: at α = 1, D = 1/π and at
   normal incidence G₁(ω_i) = 1, so a(0) = ∫ G₁(ω_o)/(4π) dω_o = ½ ∫₀¹ 2μ/(1 + μ) dμ
   = 1 − ln 2 (G₁ = 2μ/(1 + μ) at α = 1).
+- Turquin's factor at F₀ = 1 is 1/E(μ) at ω_i, so over a reciprocal base the asymmetry is
+  1 − min E/max E over the pair set's angles (derived in the test's docstring).
+- Disney's diffuse term (Burley 2012 notes §5.3, written in ``report/disney_diffuse.py``)
+  against the registered ``disney`` (its reference's code) where Schlick's factor is 0
+  (ω_i = ω_o), and F_D90 worked out by hand at normal incidence.
+- An anisotropic model's furnace: the mean and range over the azimuths, against the
+  albedo engine called at each azimuth.
 """
 
 from __future__ import annotations
