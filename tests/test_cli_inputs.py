@@ -423,7 +423,7 @@ def _imports(path: pathlib.Path) -> set[str]:
 
 def test_figure_modules_import_downward_only():
     for name in ("lewis", "lewis_spheres", "neumann", "neumann_fig8", "pumping", "models",
-                 "nielsen"):
+                 "nielsen", "energy"):
         imported = _imports(SRC / "figures" / f"{name}.py")
         assert not {m for m in imported if m.startswith("brdfkit.figures")}, (name, imported)
     assert not {m for m in _imports(SRC / "figures" / "_save.py")
@@ -431,7 +431,8 @@ def test_figure_modules_import_downward_only():
     assert set(FIGURES) == {"lewis-fig3", "lewis-fig4", "lewis-fig5", "lewis-fig6",
                             "lewis-fig7", "lewis-fig8", "lewis-fig9", "lewis-fig10",
                             "neumann-fig1", "neumann-fig3", "neumann-fig4", "neumann-fig5",
-                            "neumann-fig6", "neumann-fig7", "neumann-fig8", "nielsen-fig1"}
+                            "neumann-fig6", "neumann-fig7", "neumann-fig8", "nielsen-fig1",
+                            "energy-reciprocity"}
 
 
 def test_cli_command_modules_do_not_import_the_cli_package():
@@ -445,7 +446,7 @@ def test_cli_command_modules_do_not_import_the_cli_package():
     ctx = click.Context(main)
     assert set(main.list_commands(ctx)) == {"models", "eval", "albedo", "check", "table2",
                                             "figure", "render", "materials", "export",
-                                            "explore", "fit"}
+                                            "explore", "fit", "verdicts"}
     assert set(main.get_command(ctx, "render").commands) == {"sphere"}
 
 

@@ -21,6 +21,7 @@ import pytest
 import brdfkit
 from brdfkit.analysis import H_s, albedo, albedo_mc, check, hemispherical_albedo
 from brdfkit.analysis.chi2 import chi2_test
+from brdfkit.analysis.energy_verdict import energy_verdict
 from brdfkit.analysis.lewis_table2 import table2
 from brdfkit.models import DerivedBRDF
 from brdfkit.status import STATUS
@@ -82,7 +83,7 @@ def _nan_pdf():
     return NaNPdf(rho_d=0.5)
 
 
-def _verdict_undetermined(mp):
+def _verdict_undetermined(mp, verdict=check):
     # the node cap and no refinement: modified Phong with rho_s = 1, whose albedo at normal
     # incidence is 1 (Lewis eq. 16), cannot be certified to 1e-12 (as
     # tests/test_albedo_status.py::test_plausibility_undetermined_when_unconverged)
@@ -90,7 +91,7 @@ def _verdict_undetermined(mp):
 
     mp.setattr(eng, "MAX_ANGLE_NODES", 2000)
     mp.setattr(eng, "MAX_LEVEL", 0)
-    return check(brdfkit.model("modified-phong", rho_d=0.0, rho_s=1.0, n=2000.0), tol=1e-12)
+    return verdict(brdfkit.model("modified-phong", rho_d=0.0, rho_s=1.0, n=2000.0), tol=1e-12)
 
 
 def _ambient_limit(mp):
@@ -156,6 +157,10 @@ CASES = [
     ("verdict", "converged", lambda mp: check(brdfkit.model("lambert", rho_d=0.5))),
     ("verdict", "undetermined", _verdict_undetermined),
     ("verdict", "nonfinite", lambda mp: check(_nan_model())),
+    # energy verdicts (issue 22) carry check's status
+    ("verdict", "converged", lambda mp: energy_verdict(brdfkit.model("lambert", rho_d=0.5))),
+    ("verdict", "undetermined", lambda mp: _verdict_undetermined(mp, energy_verdict)),
+    ("verdict", "nonfinite", lambda mp: energy_verdict(_nan_model())),
     # Table 2 rows are verdicts (dicts): the same three keys
     ("verdict", "converged", lambda mp: SimpleNamespace(**table2(models=["lambert"])[0])),
     # Chi2Result

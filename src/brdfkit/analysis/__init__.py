@@ -18,6 +18,8 @@ Public objects
   (:mod:`brdfkit.analysis.plausibility`).
 - :func:`table2` — Lewis's Table 2 regenerated for every registered model
   (:mod:`brdfkit.analysis.lewis_table2`).
+- :mod:`brdfkit.analysis.energy_verdict` — one row of the energy table (issue 22):
+  check's verdict with the white furnace, E_avg and each number's accuracy.
 
 References
 ----------

@@ -64,11 +64,15 @@ from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models._base import BRDF
 from brdfkit.status import STATUS
 
-__all__ = ["Verdict", "check", "divergence_rate", "GRAZING_DEG", "RECIPROCITY_TOL"]
+__all__ = ["Verdict", "check", "divergence_rate", "reciprocity", "ENERGY_GRID_DEG", "GRAZING_DEG",
+           "RECIPROCITY_TOL"]
 
 RECIPROCITY_TOL = 1e-6
 CONSERVE_SLACK = 1e-6
 GRAZING_DEG = (89.0, 89.9, 89.99, 89.999)
+#: The incidence angles (degrees) of the energy verdict's albedo scan: 0…87° in 3° steps,
+#: 89°, 89.5° and the grazing angles (the energy tables of issue 22 scan the same grid).
+ENERGY_GRID_DEG = (*(3.0 * k for k in range(30)), 89.0, 89.5, *GRAZING_DEG[1:])
 _PAIR_THETA_DEG = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0, 85.0, 89.0, 89.9)
 _PAIR_DPHI_DEG = (0.0, 45.0, 90.0, 135.0, 180.0)
 # anisotropic models: L at absolute azimuths with no symmetry between them (a model
@@ -272,7 +276,7 @@ def check(model, *, tol: float = 1e-7, phi: float = 0.0) -> Verdict:
         recip = "undetermined"
     else:
         recip = "reciprocal" if asym <= RECIPROCITY_TOL else "not reciprocal"
-    grid = np.concatenate([np.arange(0.0, 87.01, 3.0), [89.0, 89.5], GRAZING_DEG[1:]])
+    grid = np.asarray(ENERGY_GRID_DEG)
     r = albedo(model, np.radians(grid), phi=phi_at, tol=tol)
     a = np.asarray(r.albedo).reshape(grid.size, -1)
     err = float(np.max(np.asarray(r.error)))

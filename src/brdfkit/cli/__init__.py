@@ -15,6 +15,7 @@ the command modules import :mod:`brdfkit.cli._common` and never this module.
 
 - :mod:`brdfkit.cli.model_commands` — ``models``, ``eval``.
 - :mod:`brdfkit.cli.analysis` — ``albedo``, ``check``, ``table2``, ``figure``.
+- :mod:`brdfkit.cli.energy_commands` — ``verdicts`` (the energy table of issue 22).
 - :mod:`brdfkit.cli.data_commands` — ``materials``, ``export``.
 - :mod:`brdfkit.cli.explore_commands` — ``explore`` (the browser app).
 - :mod:`brdfkit.cli.render_commands` — ``render sphere``.
@@ -55,6 +56,7 @@ _COMMANDS = {
     "albedo": "brdfkit.cli.analysis:albedo_cmd",
     "check": "brdfkit.cli.analysis:check_cmd",
     "table2": "brdfkit.cli.analysis:table2_cmd",
+    "verdicts": "brdfkit.cli.energy_commands:verdicts_cmd",
     "figure": "brdfkit.cli.analysis:figure_cmd",
     "materials": "brdfkit.cli.data_commands:materials_cmd",
     "export": "brdfkit.cli.data_commands:export_cmd",

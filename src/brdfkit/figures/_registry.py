@@ -14,7 +14,7 @@ from collections.abc import Callable, Mapping
 from types import MappingProxyType
 
 from brdfkit.errors import BrdfkitError
-from brdfkit.figures import lewis, lewis_spheres, neumann
+from brdfkit.figures import energy, lewis, lewis_spheres, neumann
 from brdfkit.figures import models as model_figures
 from brdfkit.figures import neumann_fig8 as neumann_fig8_module
 from brdfkit.figures import nielsen as nielsen_figures
@@ -42,6 +42,7 @@ FIGURES: Mapping[str, Callable] = MappingProxyType({
     "neumann-fig6": pumping_figures.neumann_fig6,
     "neumann-fig7": pumping_figures.neumann_fig7,
     "neumann-fig8": neumann_fig8_module.neumann_fig8,
+    "energy-reciprocity": energy.energy_reciprocity,
 })
 
 #: name → the keyword options a figure takes (Monte-Carlo renders: the CLI's --spp, --size,
