@@ -143,7 +143,10 @@ class CompensatedBRDF(DerivedBRDF):
             raise ParameterError(
                 f"compensate: the white form of {base.name} has {table.n_channels} channels, "
                 f"the model {n_rows}")
-        if table.clamped:
+        # warned only beyond the table's own accuracy: a lobe whose albedo reaches 1 by
+        # rounding (modified-phong n = 1 at normal incidence) is clamped silently
+        if table.clamped and (float(np.max(table.max_albedo)) > 1.0 + table.engine_tol
+                              + float(np.max(table.interp_error))):
             warnings.warn(
                 f"compensate: the albedo of {self.white.name} reaches "
                 f"{float(np.max(table.max_albedo)):.6g} > 1 (it gains energy); E is clamped "
