@@ -348,10 +348,10 @@ def cli_model(monkeypatch, model):
 
     real = cli_analysis.build_model
 
-    def build(name, params=(), pump=None, times=None):
+    def build(name, params=(), **operators):  # pump, times, compensate: passed on
         if name == "ward-aniso":
             return model
-        return real(name, params, pump=pump, times=times)
+        return real(name, params, **operators)
 
     monkeypatch.setattr(cli_analysis, "build_model", build)
     return model

@@ -345,7 +345,8 @@ def test_measured_material_means_its_furnace_goes_to_one():
 
 def test_energy_gaining_base_is_clamped_with_a_warning():
     with pytest.warns(CompensationWarning, match="clamped at 1"):
-        m = compensate(brdfkit.model("cook-torrance"))  # Neumann eq. (15): a → ∞ at 90°
+        # Lewis Table 2 (brdfkit table2): the reciprocal Phong-Blinn reaches a = 1.266 at 0°
+        m = compensate(brdfkit.model("phong-blinn-reciprocal"))
     assert m.table.clamped and "clamped" in m.table.message
 
 
