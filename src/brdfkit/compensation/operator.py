@@ -160,7 +160,8 @@ class CompensatedBRDF(DerivedBRDF):
             formulas = base.formulas()
             vector = formulas is not None and formulas.eval is not None
             kernel, driver = spec.kernel(formulas.eval if vector else base.kernel,
-                                         base.packed.shape[1], vector=vector)
+                                         base.packed.shape[1], vector=vector,
+                                         uniform=table.uniform)
         own = ("its own white form: all energy missing from its albedo (absorption "
                "included) is treated as lost to unmodelled multiple scattering, so its "
                "white furnace goes to 1 in every channel" if split is None else

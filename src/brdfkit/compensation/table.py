@@ -47,7 +47,17 @@ from brdfkit.pumping.table import (
     _engine,
     build_albedo_table,
 )
-from brdfkit.tables import LUT_TOL, Lookup, _as_2d, build_lookup, mu_of_w, theta_of_w, w_of_mu
+from brdfkit.tables import (
+    LUT_TOL,
+    Lookup,
+    UniformLookup,
+    _as_2d,
+    build_lookup,
+    build_uniform_lookup,
+    mu_of_w,
+    theta_of_w,
+    w_of_mu,
+)
 
 __all__ = ["E_FLOOR", "ENGINE_TOL", "TABLE_TOL", "CompensationTable", "compensation_table"]
 
@@ -71,6 +81,13 @@ THETA_HOLD = math.radians(89.999)
 #: Gauss–Legendre nodes on [0, 1] exact for a quartic (E·μ on one cubic piece of the lookup).
 _GL_X, _GL_W2 = np.polynomial.legendre.leggauss(3)
 _GL_T, _GL_W = 0.5 * (_GL_X + 1.0), 0.5 * _GL_W2  # mapped from [−1, 1] to [0, 1]
+#: Gauss–Legendre nodes on [0, 1] exact for degree 11: on one interval of a
+#: UniformLookup, Ẽ(w) μ(w) μ'(w) is a cubic times (2w² − w⁴)(4w − 4w³), degree 10.
+_GLW_X, _GLW_W2 = np.polynomial.legendre.leggauss(6)
+_GLW_T, _GLW_W = 0.5 * (_GLW_X + 1.0), 0.5 * _GLW_W2
+#: Most halvings of the spline's spacing tried for the single-level lookup (16× its
+#: intervals); beyond, the two-level Lookup is used.
+UNIFORM_MAX_HALVINGS = 4
 
 
 @dataclass(frozen=True)
@@ -121,6 +138,11 @@ class CompensationTable:
     def n_channels(self) -> int:
         """Channels of E (1 for a grey white form)."""
         return len(self.lookups)
+
+    @property
+    def uniform(self) -> bool:
+        """Whether the lookups are single-level (:class:`~brdfkit.tables.UniformLookup`)."""
+        return isinstance(self.lookups[0], UniformLookup)
 
     @property
     def max_error(self) -> float:
@@ -224,6 +246,70 @@ def _lookup_average(lk: Lookup) -> float:
     return float(np.sum(2.0 * mu * e * _GL_W[None, :] * width[:, None]))
 
 
+def _uniform_average(lk: UniformLookup) -> float:
+    """2∫₀¹ min(Ẽ, 1) μ dμ of a :class:`~brdfkit.tables.UniformLookup`, as the kernels
+    read it: the held value on [0, μ(w_min)] (Ẽ_min μ²), 6-point Gauss–Legendre in w on
+    each interval from w_min (exact: degree 10; where the clamp at 1 cuts one, within
+    the margin ε of it)."""
+    e = np.unique(np.clip(lk.w0 + lk.h * np.arange(lk.n + 1), lk.w_min, 1.0))
+    lo, width = e[:-1], np.diff(e)
+    w = lo[:, None] + width[:, None] * _GLW_T[None, :]
+    mu = mu_of_w(w)
+    jac = 4.0 * w * (1.0 - w * w)  # dμ/dw
+    ee = np.minimum(lk.at_w(w)[..., 0], 1.0)  # clamp: as the kernels read it
+    held = min(float(lk.at_w(np.array([lk.w_min]))[0, 0]), 1.0) * float(mu_of_w(lk.w_min)) ** 2
+    return held + float(np.sum(2.0 * mu * jac * ee * _GLW_W[None, :] * width[:, None]))
+
+
+def _uniform_lookup(spline: AlbedoTable, grazing, c: int):
+    """Channel *c* of E as a single-level :class:`~brdfkit.tables.UniformLookup`, or None.
+
+    Only for a single-piece table that E never clamps (no kink on [w(THETA_HOLD), 1]):
+    the grid is the spline's own (uniform in w, anchored at s_top), its spacing halved
+    until the lookup is within LUT_TOL of E (the spline above s_top, where the cubics
+    are the spline's own up to rounding; the grazing piece below, extended down past
+    w(THETA_HOLD), where the value is then held by the read's clamp).
+    """
+    if len(spline.piece_nn) != 1:
+        return None
+    s_top, nn = spline.s_top, spline.piece_nn[0]
+    w_hold = float(w_of_mu(math.cos(THETA_HOLD)))
+
+    def e_w(w):
+        w = np.asarray(w, dtype=np.float64)
+        e = _as_2d(spline.at_cos(mu_of_w(np.maximum(w, s_top))))[:, c:c + 1].copy()
+        below = w < s_top
+        e[below] = _as_2d(grazing(w[below]))[:, c:c + 1]
+        return np.maximum(e, E_FLOOR)  # clamp: see E_FLOOR
+
+    for r in range(UNIFORM_MAX_HALVINGS + 1):
+        h = (1.0 - s_top) / (nn << r)
+        n_ext = math.ceil((s_top - w_hold) / h - 1e-9)
+        lk = build_uniform_lookup(e_w, w0=s_top - n_ext * h, h=h, n=n_ext + (nn << r),
+                                  w_min=w_hold, bound="upper")
+        if lk.max_error <= LUT_TOL:
+            return lk
+    return None
+
+
+def _two_level(spline: AlbedoTable, grazing, c: int, clamped: bool) -> Lookup:
+    """Channel *c* of min(E, 1) as the two-level :class:`~brdfkit.tables.Lookup` (a table
+    of several pieces, or one E crosses 1 on): its kinks are the pieces' boundaries
+    (where the grazing piece meets the table, THETA_TOP), where the value is held
+    (THETA_HOLD) and where E crosses 1 (the clamp)."""
+    ks = np.concatenate([mu_of_w(spline.breaks[:-1]), [math.cos(THETA_HOLD)]])
+    if clamped:
+        grid = np.linspace(0.0, 1.0, 4097)
+        ks = np.concatenate([ks, _crossings(lambda m: _spline_e(
+            spline, grazing, m)[:, c:c + 1] - 1.0, grid, _spline_e(
+            spline, grazing, grid)[:, c:c + 1] - 1.0)])
+
+    def e_of(mu):
+        e = _spline_e(spline, grazing, mu)[:, c:c + 1]
+        return np.clip(e, E_FLOOR, 1.0)  # clamp: see E_FLOOR and the docstring (E > 1)
+    return build_lookup(e_of, kinks=ks, tol=LUT_TOL, bound="upper")
+
+
 def _spline_average(spline: AlbedoTable, grazing) -> np.ndarray:
     """2∫₀¹ min(E, 1) μ dμ of the table and its grazing piece: 64 Gauss–Legendre nodes on
     each piece in w (dμ = 4w(1 − w²) dw), the held value on [0, w(THETA_HOLD)]."""
@@ -268,22 +354,14 @@ def compensation_table(model: BRDF, *, who: str = "compensate") -> CompensationT
     grazing, grazing_err, _ = _grazing_piece(model, spline)
     max_albedo = np.maximum(spline.max_albedo, np.max(_as_2d(grazing(grazing.x)), axis=0))
     clamped = bool(np.any(max_albedo > 1.0))
-    # the pieces' boundaries (where the grazing piece meets the table, THETA_TOP) and where
-    # the value is held (THETA_HOLD)
-    kinks = np.concatenate([mu_of_w(spline.breaks[:-1]), [math.cos(THETA_HOLD)]])
-    grid = np.linspace(0.0, 1.0, 4097)
-    lookups = []
-    for c in range(max_albedo.size):
-        def e_of(mu, c=c):
-            e = _spline_e(spline, grazing, mu)[:, c:c + 1]
-            return np.clip(e, E_FLOOR, 1.0)  # clamp: see E_FLOOR and the docstring (E > 1)
-        ks = kinks
-        if clamped:  # where E crosses 1, the clamp makes a kink
-            ks = np.concatenate([ks, _crossings(lambda m, c=c: _spline_e(
-                spline, grazing, m)[:, c:c + 1] - 1.0, grid, _spline_e(
-                spline, grazing, grid)[:, c:c + 1] - 1.0)])
-        lookups.append(build_lookup(e_of, kinks=ks, tol=LUT_TOL, bound="upper"))
-    e_avg = np.array([_lookup_average(lk) for lk in lookups])
+    # one kind of lookup for every channel (the kernel reads one): single-level when each
+    # channel's E allows it, else the two-level Lookup
+    lookups = [None if clamped else _uniform_lookup(spline, grazing, c)
+               for c in range(max_albedo.size)]
+    if any(lk is None for lk in lookups):
+        lookups = [_two_level(spline, grazing, c, clamped) for c in range(max_albedo.size)]
+    e_avg = np.array([_uniform_average(lk) if isinstance(lk, UniformLookup)
+                      else _lookup_average(lk) for lk in lookups])
     e_avg_error = np.abs(e_avg - _spline_average(spline, grazing))
     return CompensationTable(
         spline=spline, lookups=tuple(lookups), e_avg=e_avg, e_avg_error=e_avg_error,
