@@ -181,6 +181,11 @@ class CompensatedBRDF(DerivedBRDF):
         self.albedo_kinks = base.albedo_kinks
         self.albedo_kink_mus = base.albedo_kink_mus
 
+    def albedo_kinks_nv(self, theta):
+        """The base's kink circles N·V = k (the compensation multiplies or adds functions of
+        μ_i and μ_o only, so the base's kinks stay and no new circle appears)."""
+        return self.base.albedo_kinks_nv(theta)
+
     # ---------------------------------------------------------------- packing
     def _pack(self) -> np.ndarray:
         """Per channel c: the base's row, the constant at p[K], the lookup of Ẽ at p[K+1:]

@@ -185,6 +185,14 @@ class CompensationTable:
                 "message": self.message}
 
 
+def _engine_tol(model: BRDF) -> float:
+    """:data:`ENGINE_TOL`, or the smaller tolerance the model asks its albedo tables for
+    (``albedo_engine_tol``: a kink the engine cannot be told of, e.g. the rough diffuse
+    models' azimuth 90°, where the engine's estimate at ENGINE_TOL is not honest)."""
+    tol = getattr(model, "albedo_engine_tol", None)
+    return ENGINE_TOL if tol is None else min(ENGINE_TOL, float(tol))
+
+
 def _grazing_piece(model: BRDF, spline: AlbedoTable):
     """E on [w(THETA_HOLD), w(THETA_TOP)]: the engine's values, a cubic spline in w.
 
@@ -197,7 +205,7 @@ def _grazing_piece(model: BRDF, spline: AlbedoTable):
     """
     from scipy.interpolate import CubicSpline
 
-    run = _engine(model, ENGINE_TOL)
+    run = _engine(model, _engine_tol(model))
     w0, w1 = float(w_of_mu(math.cos(THETA_HOLD))), spline.s_top
     nn, n_eval = 8, 0
     while True:
@@ -349,7 +357,7 @@ def compensation_table(model: BRDF, *, who: str = "compensate") -> CompensationT
             "incidence angle only, which needs an isotropic base (docs/compensation.md, "
             "'Anisotropic bases')")
     t0 = time.perf_counter()
-    spline = build_albedo_table(model, tol=TABLE_TOL, engine_tol=ENGINE_TOL, margin=False,
+    spline = build_albedo_table(model, tol=TABLE_TOL, engine_tol=_engine_tol(model), margin=False,
                                 who=who)
     grazing, grazing_err, _ = _grazing_piece(model, spline)
     max_albedo = np.maximum(spline.max_albedo, np.max(_as_2d(grazing(grazing.x)), axis=0))
@@ -368,4 +376,4 @@ def compensation_table(model: BRDF, *, who: str = "compensate") -> CompensationT
         max_albedo=max_albedo, clamped=clamped,
         interp_error=np.maximum(spline.max_midpoint_error, grazing_err),
         lookup_error=float(max(lk.max_error + lk.epsilon for lk in lookups)),
-        engine_tol=ENGINE_TOL, seconds=time.perf_counter() - t0)
+        engine_tol=_engine_tol(model), seconds=time.perf_counter() - t0)
