@@ -30,8 +30,8 @@ Public objects
 - :class:`Lookup`, :func:`build_lookup` — the kernels' table of a function of cos θ.
 - :func:`_lookup` — its compiled read (``@njit(inline="always")``, for kernels).
 - :class:`UniformLookup`, :func:`build_uniform_lookup`, :func:`_lookup_w` — a
-  single-level table uniform in w (4 reads, for a function smooth in w: a
-  compensation's E(μ)).
+  single-level table uniform in √μ (4 reads, one square root, for a function smooth
+  in √μ: a compensation's E(μ)).
 - :data:`LUT_TOL`, :data:`LUT_CELLS` — the lookup's default tolerance and cells.
 """
 
@@ -338,22 +338,20 @@ def _horner(coef: np.ndarray, tc: np.ndarray) -> np.ndarray:
     return ((c[..., 0] * t + c[..., 1]) * t + c[..., 2]) * t + c[..., 3]
 
 
-# ------------------------------------------------------------- single-level lookup in w
+# ------------------------------------------------------------- single-level lookup in √μ
 @numba.njit(cache=True, inline="always")
 def _lookup_w(p, off, mu):  # pragma: no cover - compiled
     """Value at μ = *mu* of the :class:`UniformLookup` stored at ``p[off:]``.
 
-    One level: w = √(1 − √(1 − μ)) (two square roots; the printed form, not
-    :func:`w_of_mu`'s, which costs a division: its cancellation at grazing is ≤ 2e-16/μ
-    relative in w², 1e-11 at the table's last angle, far below its error), held at
-    w_min below it (a select), the interval ``int((w − w₀)/h)`` clamped to
+    One level: x = √μ (one square root), held at x_min below it (a select), the
+    interval ``int((x − x₀)/h)`` clamped to
     [0, n − 1] by selects, then 4 reads and Horner. Branch-free and every read a
     :func:`brdfkit._kern.load_input`, as :func:`_lookup`, so it vectorises to gathers.
     """
     mu = clamp_unit(mu)  # [0, 1], NaN to 0: every index in range for any input
-    w = math.sqrt(1.0 - math.sqrt(1.0 - mu))  # see the docstring
+    w = math.sqrt(mu)
     w_min = load_input(p, off + 3)
-    w = w if w > w_min else w_min  # held below w_min (the table's last angle)
+    w = w if w > w_min else w_min  # held below x_min (the table's last angle)
     x = (w - load_input(p, off)) * load_input(p, off + 1)
     n = numba.int64(load_input(p, off + 2))  # casts: int() is a call (see _lookup)
     j = numba.int64(x)
@@ -367,8 +365,13 @@ def _lookup_w(p, off, mu):  # pragma: no cover - compiled
 
 @dataclass(frozen=True)
 class UniformLookup:
-    """A positive function of μ stored on one grid uniform in w = √(1 − √(1 − μ)).
+    """A positive function of μ stored on one grid uniform in x = √μ.
 
+    x behaves at grazing like the shared grid variable w = √(1 − √(1 − μ)) (x ≈ √2 w:
+    a function like √μ there, a compensation's E, is smooth in it), and near the normal
+    like μ (where an isotropic model's albedo is smooth in μ), for one square root (w
+    costs two; measured: the square roots were ~0.25× of a GGX evaluation in
+    Kulla–Conty's two reads). The class and its fields keep the name w for x.
     Intervals [w₀ + j h, w₀ + (j + 1) h], j < n, each with its cubic in t ∈ [0, 1]
     (the cubic through the function at t = 0, ⅓, ⅔, 1), the function held at its value
     at w_min below w_min. Read by :func:`_lookup_w` with 4 reads (the two-level
@@ -401,7 +404,7 @@ class UniformLookup:
                                self.data[c].reshape(-1)])
 
     def at_w(self, w) -> np.ndarray:
-        """The stored cubics at w (held below w_min): shape ``w.shape + (C,)``."""
+        """The stored cubics at x = √μ = *w* (held below w_min): ``w.shape + (C,)``."""
         x = (np.maximum(np.asarray(w, dtype=np.float64), self.w_min) - self.w0) / self.h
         j = np.clip(x.astype(np.int64), 0, self.n - 1)
         d = self.data[:, j, :]  # (C, ..., 4)
@@ -412,12 +415,12 @@ class UniformLookup:
     def __call__(self, mu) -> np.ndarray:
         """Vectorised :func:`_lookup_w`: shape ``mu.shape + (C,)``."""
         mu = np.clip(np.nan_to_num(np.asarray(mu, dtype=np.float64), nan=0.0), 0.0, 1.0)
-        return self.at_w(np.sqrt(1.0 - np.sqrt(1.0 - mu)))  # as _lookup_w computes it
+        return self.at_w(np.sqrt(mu))  # as _lookup_w computes it
 
 
 def build_uniform_lookup(fn_w: Callable, *, w0: float, h: float, n: int, w_min: float,
                          bound: str = "upper") -> UniformLookup:
-    """Tabulate *fn_w* (w of shape (T,) → positive (T, C)) as a :class:`UniformLookup`
+    """Tabulate *fn_w* (x = √μ of shape (T,) → positive (T, C)) as a :class:`UniformLookup`
     on the *n* intervals from *w0* with spacing *h* (w0 ≤ w_min, w0 + n h ≥ 1); the
     caller checks ``max_error`` against its tolerance. The bound is verified at every
     check point after the margin, as :func:`build_lookup`'s.

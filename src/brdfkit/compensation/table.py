@@ -82,11 +82,11 @@ THETA_HOLD = math.radians(89.999)
 _GL_X, _GL_W2 = np.polynomial.legendre.leggauss(3)
 _GL_T, _GL_W = 0.5 * (_GL_X + 1.0), 0.5 * _GL_W2  # mapped from [−1, 1] to [0, 1]
 #: Gauss–Legendre nodes on [0, 1] exact for degree 11: on one interval of a
-#: UniformLookup, Ẽ(w) μ(w) μ'(w) is a cubic times (2w² − w⁴)(4w − 4w³), degree 10.
+#: UniformLookup, Ẽ(x) μ dμ/dx (x = √μ) is a cubic times 2x³, degree 6.
 _GLW_X, _GLW_W2 = np.polynomial.legendre.leggauss(6)
 _GLW_T, _GLW_W = 0.5 * (_GLW_X + 1.0), 0.5 * _GLW_W2
-#: Most halvings of the spline's spacing tried for the single-level lookup (16× its
-#: intervals); beyond, the two-level Lookup is used.
+#: Most doublings of the single-level lookup's intervals from the spline's count (16×);
+#: beyond, the two-level Lookup is used.
 UNIFORM_MAX_HALVINGS = 4
 
 
@@ -256,45 +256,44 @@ def _lookup_average(lk: Lookup) -> float:
 
 def _uniform_average(lk: UniformLookup) -> float:
     """2∫₀¹ min(Ẽ, 1) μ dμ of a :class:`~brdfkit.tables.UniformLookup`, as the kernels
-    read it: the held value on [0, μ(w_min)] (Ẽ_min μ²), 6-point Gauss–Legendre in w on
-    each interval from w_min (exact: degree 10; where the clamp at 1 cuts one, within
-    the margin ε of it)."""
+    read it: the held value on [0, μ_min] (Ẽ_min μ_min², μ_min = x_min²), 6-point
+    Gauss–Legendre in x = √μ on each interval from x_min (exact: Ẽ μ dμ/dx = cubic · 2x³,
+    degree 6; where the clamp at 1 cuts one, within the margin ε of it)."""
     e = np.unique(np.clip(lk.w0 + lk.h * np.arange(lk.n + 1), lk.w_min, 1.0))
     lo, width = e[:-1], np.diff(e)
-    w = lo[:, None] + width[:, None] * _GLW_T[None, :]
-    mu = mu_of_w(w)
-    jac = 4.0 * w * (1.0 - w * w)  # dμ/dw
-    ee = np.minimum(lk.at_w(w)[..., 0], 1.0)  # clamp: as the kernels read it
-    held = min(float(lk.at_w(np.array([lk.w_min]))[0, 0]), 1.0) * float(mu_of_w(lk.w_min)) ** 2
-    return held + float(np.sum(2.0 * mu * jac * ee * _GLW_W[None, :] * width[:, None]))
+    x = lo[:, None] + width[:, None] * _GLW_T[None, :]
+    ee = np.minimum(lk.at_w(x)[..., 0], 1.0)  # clamp: as the kernels read it
+    held = min(float(lk.at_w(np.array([lk.w_min]))[0, 0]), 1.0) * lk.w_min ** 4
+    return held + float(np.sum(4.0 * x ** 3 * ee * _GLW_W[None, :] * width[:, None]))
 
 
 def _uniform_lookup(spline: AlbedoTable, grazing, c: int):
     """Channel *c* of E as a single-level :class:`~brdfkit.tables.UniformLookup`, or None.
 
-    Only for a single-piece table that E never clamps (no kink on [w(THETA_HOLD), 1]):
-    the grid is the spline's own (uniform in w, anchored at s_top), its spacing halved
-    until the lookup is within LUT_TOL of E (the spline above s_top, where the cubics
-    are the spline's own up to rounding; the grazing piece below, extended down past
-    w(THETA_HOLD), where the value is then held by the read's clamp).
+    Only for a single-piece table that E never clamps (no kink on [THETA_HOLD, 0°]):
+    a grid uniform in x = √μ anchored at THETA_TOP, where the spline meets the grazing
+    piece, extended below it by whole intervals past THETA_HOLD (below which the read's
+    clamp holds the value); as many intervals as the spline's to start, doubled (at most
+    UNIFORM_MAX_HALVINGS times) until the lookup is within LUT_TOL of E.
     """
     if len(spline.piece_nn) != 1:
         return None
-    s_top, nn = spline.s_top, spline.piece_nn[0]
-    w_hold = float(w_of_mu(math.cos(THETA_HOLD)))
+    x_top = math.sqrt(math.cos(THETA_TOP))
+    x_hold = math.sqrt(math.cos(THETA_HOLD))
 
-    def e_w(w):
-        w = np.asarray(w, dtype=np.float64)
-        e = _as_2d(spline.at_cos(mu_of_w(np.maximum(w, s_top))))[:, c:c + 1].copy()
-        below = w < s_top
-        e[below] = _as_2d(grazing(w[below]))[:, c:c + 1]
+    def e_x(x):
+        mu = np.square(np.asarray(x, dtype=np.float64))
+        e = _as_2d(spline.at_cos(np.maximum(mu, mu_of_w(spline.s_top))))[:, c:c + 1].copy()
+        below = x < x_top
+        e[below] = _as_2d(grazing(w_of_mu(mu[below])))[:, c:c + 1]
         return np.maximum(e, E_FLOOR)  # clamp: see E_FLOOR
 
     for r in range(UNIFORM_MAX_HALVINGS + 1):
-        h = (1.0 - s_top) / (nn << r)
-        n_ext = math.ceil((s_top - w_hold) / h - 1e-9)
-        lk = build_uniform_lookup(e_w, w0=s_top - n_ext * h, h=h, n=n_ext + (nn << r),
-                                  w_min=w_hold, bound="upper")
+        n_top = spline.piece_nn[0] << r
+        h = (1.0 - x_top) / n_top
+        n_ext = math.ceil((x_top - x_hold) / h - 1e-9)
+        lk = build_uniform_lookup(e_x, w0=x_top - n_ext * h, h=h, n=n_ext + n_top,
+                                  w_min=x_hold, bound="upper")
         if lk.max_error <= LUT_TOL:
             return lk
     return None
