@@ -13,9 +13,12 @@ already has (``docs/compensation.md``, "Tables and their accuracy"):
    they meet :data:`TABLE_TOL` at every interval midpoint — pumping's
    :func:`~brdfkit.pumping.table.build_albedo_table` with ``margin=False``: the
    accurate interpolant, not pumping's upper bound;
-2. the kernel's :class:`~brdfkit.tables.Lookup` of min(E, 1) (an upper bound of it
-   within :data:`~brdfkit.tables.LUT_TOL`; the kernels clamp what they read at 1, so
-   Ẽ ≥ min(E, 1) and 0 ≤ 1 − Ẽ);
+2. the kernel's lookup of min(E, 1) (an upper bound of it within
+   :data:`~brdfkit.tables.LUT_TOL`; the kernels clamp what they read at 1, so
+   Ẽ ≥ min(E, 1) and 0 ≤ 1 − Ẽ): a single-level
+   :class:`~brdfkit.tables.UniformLookup` in √μ (4 reads) for a table of one piece E
+   never clamps (:func:`_uniform_lookup`), else the two-level
+   :class:`~brdfkit.tables.Lookup` (:func:`_two_level`);
 3. E_avg integrated *from the clamped lookup itself* (3-point Gauss–Legendre on each
    of its cubic pieces, exact where E·μ is a quartic). So the Kulla–Conty lobe's own
    normalisation 2∫(1 − Ẽ)μ dμ = 1 − E_avg holds with the Ẽ the kernel reads, and
@@ -98,7 +101,7 @@ class CompensationTable:
     ----------
     spline : AlbedoTable
         The engine's values interpolated (pumping's builder, ``margin=False``).
-    lookups : tuple of Lookup
+    lookups : tuple of UniformLookup or of Lookup
         Per channel of E, the kernel's table of min(E, 1) (an upper bound within
         ``lookup_error``, relative; read clamped at 1).
     e_avg : ndarray (C,)
