@@ -29,6 +29,9 @@ Public objects
 - :func:`w_of_mu`, :func:`mu_of_w`, :func:`theta_of_w` — the grid variable.
 - :class:`Lookup`, :func:`build_lookup` — the kernels' table of a function of cos θ.
 - :func:`_lookup` — its compiled read (``@njit(inline="always")``, for kernels).
+- :class:`UniformLookup`, :func:`build_uniform_lookup`, :func:`_lookup_w` — a
+  single-level table uniform in √μ (4 reads, one square root, for a function smooth
+  in √μ: a compensation's E(μ)).
 - :data:`LUT_TOL`, :data:`LUT_CELLS` — the lookup's default tolerance and cells.
 """
 
@@ -48,7 +51,9 @@ __all__ = [
     "LUT_CELLS",
     "LUT_TOL",
     "Lookup",
+    "UniformLookup",
     "build_lookup",
+    "build_uniform_lookup",
     "mu_of_w",
     "theta_of_w",
     "w_of_mu",
@@ -331,3 +336,120 @@ def _horner(coef: np.ndarray, tc: np.ndarray) -> np.ndarray:
     c = coef[:, None, :, :]
     t = tc[:, :, None]
     return ((c[..., 0] * t + c[..., 1]) * t + c[..., 2]) * t + c[..., 3]
+
+
+# ------------------------------------------------------------- single-level lookup in √μ
+@numba.njit(cache=True, inline="always")
+def _lookup_w(p, off, mu):  # pragma: no cover - compiled
+    """Value at μ = *mu* of the :class:`UniformLookup` stored at ``p[off:]``.
+
+    One level: x = √μ (one square root), held at x_min below it (a select), the
+    interval ``int((x − x₀)/h)`` clamped to
+    [0, n − 1] by selects, then 4 reads and Horner. Branch-free and every read a
+    :func:`brdfkit._kern.load_input`, as :func:`_lookup`, so it vectorises to gathers.
+    """
+    mu = clamp_unit(mu)  # [0, 1], NaN to 0: every index in range for any input
+    w = math.sqrt(mu)
+    w_min = load_input(p, off + 3)
+    w = w if w > w_min else w_min  # held below x_min (the table's last angle)
+    x = (w - load_input(p, off)) * load_input(p, off + 1)
+    n = numba.int64(load_input(p, off + 2))  # casts: int() is a call (see _lookup)
+    j = numba.int64(x)
+    j = j if j < n - 1 else n - 1  # w = 1: the last interval
+    j = j if j > 0 else 0  # rounding below w0
+    t = x - j
+    b = off + 4 + 4 * j
+    return (((load_input(p, b) * t + load_input(p, b + 1)) * t + load_input(p, b + 2)) * t
+            + load_input(p, b + 3))
+
+
+@dataclass(frozen=True)
+class UniformLookup:
+    """A positive function of μ stored on one grid uniform in x = √μ.
+
+    x behaves at grazing like the shared grid variable w = √(1 − √(1 − μ)) (x ≈ √2 w:
+    a function like √μ there, a compensation's E, is smooth in it), and near the normal
+    like μ (where an isotropic model's albedo is smooth in μ), for one square root (w
+    costs two; measured: the square roots were ~0.25× of a GGX evaluation in
+    Kulla–Conty's two reads). The class and its fields keep the name w for x.
+    Intervals [w₀ + j h, w₀ + (j + 1) h], j < n, each with its cubic in t ∈ [0, 1]
+    (the cubic through the function at t = 0, ⅓, ⅔, 1), the function held at its value
+    at w_min below w_min. Read by :func:`_lookup_w` with 4 reads (the two-level
+    :class:`Lookup` needs 8, 4 of them dependent on the other 4), for a function smooth
+    in w on [w_min, 1] (a kink would need refinement of the whole grid). Scaled by
+    (1 ± ε) like :class:`Lookup`, so it bounds the function from the side *bound*.
+
+    Attributes: ``w0``, ``h``, ``n``, ``w_min``, ``data`` (C, n, 4), ``max_error``
+    (largest relative error before the margin at ``LUT_CHECK`` points per interval),
+    ``epsilon``, ``bound``.
+    """
+
+    w0: float
+    h: float
+    n: int
+    w_min: float
+    data: np.ndarray
+    max_error: float
+    epsilon: float
+    bound: str
+
+    @property
+    def n_intervals(self) -> int:
+        """Total number of intervals."""
+        return self.n
+
+    def packed(self, c: int) -> np.ndarray:
+        """Channel *c* flattened for :func:`_lookup_w`."""
+        return np.concatenate([[self.w0, 1.0 / self.h, float(self.n), self.w_min],
+                               self.data[c].reshape(-1)])
+
+    def at_w(self, w) -> np.ndarray:
+        """The stored cubics at x = √μ = *w* (held below w_min): ``w.shape + (C,)``."""
+        x = (np.maximum(np.asarray(w, dtype=np.float64), self.w_min) - self.w0) / self.h
+        j = np.clip(x.astype(np.int64), 0, self.n - 1)
+        d = self.data[:, j, :]  # (C, ..., 4)
+        t = x - j
+        out = ((d[..., 0] * t + d[..., 1]) * t + d[..., 2]) * t + d[..., 3]
+        return np.moveaxis(out, 0, -1)
+
+    def __call__(self, mu) -> np.ndarray:
+        """Vectorised :func:`_lookup_w`: shape ``mu.shape + (C,)``."""
+        mu = np.clip(np.nan_to_num(np.asarray(mu, dtype=np.float64), nan=0.0), 0.0, 1.0)
+        return self.at_w(np.sqrt(mu))  # as _lookup_w computes it
+
+
+def build_uniform_lookup(fn_w: Callable, *, w0: float, h: float, n: int, w_min: float,
+                         bound: str = "upper") -> UniformLookup:
+    """Tabulate *fn_w* (x = √μ of shape (T,) → positive (T, C)) as a :class:`UniformLookup`
+    on the *n* intervals from *w0* with spacing *h* (w0 ≤ w_min, w0 + n h ≥ 1); the
+    caller checks ``max_error`` against its tolerance. The bound is verified at every
+    check point after the margin, as :func:`build_lookup`'s.
+    """
+    if bound not in ("upper", "lower"):
+        raise ParameterError(
+            f"build_uniform_lookup: bound must be 'upper' or 'lower'; got {bound!r}")
+    x = w0 + h * np.arange(n)
+    v = _as_2d(np.asarray(fn_w(np.append(x[:, None] + h * np.arange(3)[None, :] / 3.0,
+                                         [w0 + n * h])), dtype=np.float64))
+    # check points inside [w_min, 1] only (the first interval starts below w_min)
+    t_chk = (np.arange(LUT_CHECK) + 0.5) / LUT_CHECK
+    xc = np.clip(x[:, None] + h * t_chk[None, :], w_min, 1.0)
+    tc = (xc - x[:, None]) / h
+    c = _as_2d(np.asarray(fn_w(xc.reshape(-1)), dtype=np.float64)).reshape(n, LUT_CHECK, -1)
+    if not (np.all(np.isfinite(v)) and np.all(v > 0.0) and np.all(np.isfinite(c))
+            and np.all(c > 0.0)):
+        raise BrdfkitError("build_uniform_lookup: the function must be finite and positive")
+    cub = _cubics(v)
+    worst = float(np.max(np.abs(_horner(cub, tc) - c) / c))
+    sign = 1.0 if bound == "upper" else -1.0
+    eps = 4.0 * np.finfo(float).eps
+    for _ in range(8):  # margin: twice the largest deficit, then verified
+        deficit = float(np.max(sign * (c - _horner(cub * (1.0 + sign * eps), tc)) / c))
+        if deficit <= 0.0:
+            break
+        eps += 2.0 * deficit
+    else:  # pragma: no cover - the deficit shrinks geometrically
+        raise BrdfkitError("build_uniform_lookup: could not make the lookup a bound")
+    data = np.ascontiguousarray(np.transpose(cub * (1.0 + sign * eps), (1, 0, 2)))
+    return UniformLookup(w0=float(w0), h=float(h), n=int(n), w_min=float(w_min), data=data,
+                         max_error=worst, epsilon=eps, bound=bound)

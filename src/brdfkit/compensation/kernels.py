@@ -10,8 +10,9 @@ module cached on disk) and memoised per (base kernel, offset).
 
 Packed row of one channel (``p``): the base's K parameters, then the channel's
 constant at ``p[K]`` (Kulla–Conty: F_ms/(π(1 − E_avg)); Turquin: F₀), then the
-:class:`~brdfkit.tables.Lookup` of Ẽ at ``p[K + 1:]`` (padded to the longest
-channel's). The lookup is an upper bound of min(E, 1) within its margin; the kernels
+lookup of Ẽ at ``p[K + 1:]`` (padded to the longest channel's): a single-level
+:class:`~brdfkit.tables.UniformLookup` (4 reads) for a table of one smooth piece, else
+the two-level :class:`~brdfkit.tables.Lookup` (8). The lookup is an upper bound of min(E, 1) within its margin; the kernels
 clamp what they read at 1 (:func:`_e`), so 1 − Ẽ ≥ 0 and the compensated albedo
 1 + E − Ẽ never exceeds 1 by the table's error (``docs/compensation.md``).
 
@@ -30,20 +31,28 @@ import numba
 
 from brdfkit._kern import load_input, load_inputs
 from brdfkit.models._drivers import VECTOR_OPTIONS, composed
-from brdfkit.tables import _lookup
+from brdfkit.tables import _lookup, _lookup_w
 
 __all__ = ["kulla_conty_kernel", "turquin_kernel"]
 
-# The templates' globals, bound per composition (models/_drivers.composed): the base kernel
-# and the compile-time offset of the channel's constant.
+# The templates' globals, bound per composition (models/_drivers.composed): the base kernel,
+# the compile-time offset of the channel's constant, and the read of Ẽ (_e_two_level or
+# _e_uniform, as the table stores it).
 base_kernel = None  # a kernel (ix, iy, iz, ox, oy, oz, p) -> float
 k = 0
+_e = None  # (p, off, mu) -> min(Ẽ(mu), 1)
 
 
 @numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
-def _e(p, off, mu):  # pragma: no cover - compiled (inlined into the templates)
+def _e_two_level(p, off, mu):  # pragma: no cover - compiled (inlined into the templates)
     e = _lookup(p, off, mu)
     return e if e < 1.0 else 1.0  # clamp (a select): the lookup's margin may exceed min(E, 1) = 1
+
+
+@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+def _e_uniform(p, off, mu):  # pragma: no cover - compiled (inlined into the templates)
+    e = _lookup_w(p, off, mu)
+    return e if e < 1.0 else 1.0  # clamp (a select), as _e_two_level
 
 
 def _kulla_conty(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
@@ -91,18 +100,21 @@ def _options(vector: bool) -> tuple[str, dict]:
     return ("vector", {"inline": "always", **VECTOR_OPTIONS}) if vector else ("checked", None)
 
 
-def kulla_conty_kernel(base_kernel, k: int, *, vector: bool = False):
+def kulla_conty_kernel(base_kernel, k: int, *, vector: bool = False, uniform: bool = False):
     """(kernel, driver) of f_base + p[k] (1 − Ẽ(N·L))(1 − Ẽ(N·V)) (cached). *vector*: the
     base kernel is branch-free and total (a formula of :mod:`brdfkit._dual`), so the
-    composition runs in the vectorising loop."""
+    composition runs in the vectorising loop. *uniform*: Ẽ is a
+    :class:`~brdfkit.tables.UniformLookup` (else a :class:`~brdfkit.tables.Lookup`)."""
     loop, options = _options(vector)
     template = _kulla_conty_vector if vector else _kulla_conty
-    return composed(template, loop=loop, options=options, base_kernel=base_kernel, k=int(k))
+    return composed(template, loop=loop, options=options, base_kernel=base_kernel, k=int(k),
+                    _e=_e_uniform if uniform else _e_two_level)
 
 
-def turquin_kernel(base_kernel, k: int, *, vector: bool = False):
-    """(kernel, driver) of f_base (1 + p[k] (1 − Ẽ(N·L))/Ẽ(N·L)) (cached); *vector* as
-    :func:`kulla_conty_kernel`."""
+def turquin_kernel(base_kernel, k: int, *, vector: bool = False, uniform: bool = False):
+    """(kernel, driver) of f_base (1 + p[k] (1 − Ẽ(N·L))/Ẽ(N·L)) (cached); *vector* and
+    *uniform* as :func:`kulla_conty_kernel`."""
     loop, options = _options(vector)
     template = _turquin_vector if vector else _turquin
-    return composed(template, loop=loop, options=options, base_kernel=base_kernel, k=int(k))
+    return composed(template, loop=loop, options=options, base_kernel=base_kernel, k=int(k),
+                    _e=_e_uniform if uniform else _e_two_level)

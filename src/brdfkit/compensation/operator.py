@@ -163,7 +163,8 @@ class CompensatedBRDF(DerivedBRDF):
             formulas = base.formulas()
             vector = formulas is not None and formulas.eval is not None
             kernel, driver = spec.kernel(formulas.eval if vector else base.kernel,
-                                         base.packed.shape[1], vector=vector)
+                                         base.packed.shape[1], vector=vector,
+                                         uniform=table.uniform)
         own = ("its own white form: all energy missing from its albedo (absorption "
                "included) is treated as lost to unmodelled multiple scattering, so its "
                "white furnace goes to 1 in every channel" if split is None else
@@ -182,6 +183,11 @@ class CompensatedBRDF(DerivedBRDF):
         self.n_channels = base.n_channels
         self.albedo_kinks = base.albedo_kinks
         self.albedo_kink_mus = base.albedo_kink_mus
+
+    def albedo_kinks_nv(self, theta):
+        """The base's kink circles N·V = k (the compensation multiplies or adds functions of
+        μ_i and μ_o only, so the base's kinks stay and no new circle appears)."""
+        return self.base.albedo_kinks_nv(theta)
 
     # ---------------------------------------------------------------- packing
     def _pack(self) -> np.ndarray:

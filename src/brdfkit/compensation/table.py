@@ -13,9 +13,12 @@ already has (``docs/compensation.md``, "Tables and their accuracy"):
    they meet :data:`TABLE_TOL` at every interval midpoint — pumping's
    :func:`~brdfkit.pumping.table.build_albedo_table` with ``margin=False``: the
    accurate interpolant, not pumping's upper bound;
-2. the kernel's :class:`~brdfkit.tables.Lookup` of min(E, 1) (an upper bound of it
-   within :data:`~brdfkit.tables.LUT_TOL`; the kernels clamp what they read at 1, so
-   Ẽ ≥ min(E, 1) and 0 ≤ 1 − Ẽ);
+2. the kernel's lookup of min(E, 1) (an upper bound of it within
+   :data:`~brdfkit.tables.LUT_TOL`; the kernels clamp what they read at 1, so
+   Ẽ ≥ min(E, 1) and 0 ≤ 1 − Ẽ): a single-level
+   :class:`~brdfkit.tables.UniformLookup` in √μ (4 reads) for a table of one piece E
+   never clamps (:func:`_uniform_lookup`), else the two-level
+   :class:`~brdfkit.tables.Lookup` (:func:`_two_level`);
 3. E_avg integrated *from the clamped lookup itself* (3-point Gauss–Legendre on each
    of its cubic pieces, exact where E·μ is a quartic). So the Kulla–Conty lobe's own
    normalisation 2∫(1 − Ẽ)μ dμ = 1 − E_avg holds with the Ẽ the kernel reads, and
@@ -47,7 +50,17 @@ from brdfkit.pumping.table import (
     _engine,
     build_albedo_table,
 )
-from brdfkit.tables import LUT_TOL, Lookup, _as_2d, build_lookup, mu_of_w, theta_of_w, w_of_mu
+from brdfkit.tables import (
+    LUT_TOL,
+    Lookup,
+    UniformLookup,
+    _as_2d,
+    build_lookup,
+    build_uniform_lookup,
+    mu_of_w,
+    theta_of_w,
+    w_of_mu,
+)
 
 __all__ = ["E_FLOOR", "ENGINE_TOL", "TABLE_TOL", "CompensationTable", "compensation_table"]
 
@@ -71,6 +84,13 @@ THETA_HOLD = math.radians(89.999)
 #: Gauss–Legendre nodes on [0, 1] exact for a quartic (E·μ on one cubic piece of the lookup).
 _GL_X, _GL_W2 = np.polynomial.legendre.leggauss(3)
 _GL_T, _GL_W = 0.5 * (_GL_X + 1.0), 0.5 * _GL_W2  # mapped from [−1, 1] to [0, 1]
+#: Gauss–Legendre nodes on [0, 1] exact for degree 11: on one interval of a
+#: UniformLookup, Ẽ(x) μ dμ/dx (x = √μ) is a cubic times 2x³, degree 6.
+_GLW_X, _GLW_W2 = np.polynomial.legendre.leggauss(6)
+_GLW_T, _GLW_W = 0.5 * (_GLW_X + 1.0), 0.5 * _GLW_W2
+#: Most doublings of the single-level lookup's intervals from the spline's count (16×);
+#: beyond, the two-level Lookup is used.
+UNIFORM_MAX_HALVINGS = 4
 
 
 @dataclass(frozen=True)
@@ -81,7 +101,7 @@ class CompensationTable:
     ----------
     spline : AlbedoTable
         The engine's values interpolated (pumping's builder, ``margin=False``).
-    lookups : tuple of Lookup
+    lookups : tuple of UniformLookup or of Lookup
         Per channel of E, the kernel's table of min(E, 1) (an upper bound within
         ``lookup_error``, relative; read clamped at 1).
     e_avg : ndarray (C,)
@@ -121,6 +141,11 @@ class CompensationTable:
     def n_channels(self) -> int:
         """Channels of E (1 for a grey white form)."""
         return len(self.lookups)
+
+    @property
+    def uniform(self) -> bool:
+        """Whether the lookups are single-level (:class:`~brdfkit.tables.UniformLookup`)."""
+        return isinstance(self.lookups[0], UniformLookup)
 
     @property
     def max_error(self) -> float:
@@ -163,6 +188,14 @@ class CompensationTable:
                 "message": self.message}
 
 
+def _engine_tol(model: BRDF) -> float:
+    """:data:`ENGINE_TOL`, or the smaller tolerance the model asks its albedo tables for
+    (``albedo_engine_tol``: a kink the engine cannot be told of, e.g. the rough diffuse
+    models' azimuth 90°, where the engine's estimate at ENGINE_TOL is not honest)."""
+    tol = getattr(model, "albedo_engine_tol", None)
+    return ENGINE_TOL if tol is None else min(ENGINE_TOL, float(tol))
+
+
 def _grazing_piece(model: BRDF, spline: AlbedoTable):
     """E on [w(THETA_HOLD), w(THETA_TOP)]: the engine's values, a cubic spline in w.
 
@@ -175,7 +208,7 @@ def _grazing_piece(model: BRDF, spline: AlbedoTable):
     """
     from scipy.interpolate import CubicSpline
 
-    run = _engine(model, ENGINE_TOL)
+    run = _engine(model, _engine_tol(model))
     w0, w1 = float(w_of_mu(math.cos(THETA_HOLD))), spline.s_top
     nn, n_eval = 8, 0
     while True:
@@ -224,6 +257,69 @@ def _lookup_average(lk: Lookup) -> float:
     return float(np.sum(2.0 * mu * e * _GL_W[None, :] * width[:, None]))
 
 
+def _uniform_average(lk: UniformLookup) -> float:
+    """2∫₀¹ min(Ẽ, 1) μ dμ of a :class:`~brdfkit.tables.UniformLookup`, as the kernels
+    read it: the held value on [0, μ_min] (Ẽ_min μ_min², μ_min = x_min²), 6-point
+    Gauss–Legendre in x = √μ on each interval from x_min (exact: Ẽ μ dμ/dx = cubic · 2x³,
+    degree 6; where the clamp at 1 cuts one, within the margin ε of it)."""
+    e = np.unique(np.clip(lk.w0 + lk.h * np.arange(lk.n + 1), lk.w_min, 1.0))
+    lo, width = e[:-1], np.diff(e)
+    x = lo[:, None] + width[:, None] * _GLW_T[None, :]
+    ee = np.minimum(lk.at_w(x)[..., 0], 1.0)  # clamp: as the kernels read it
+    held = min(float(lk.at_w(np.array([lk.w_min]))[0, 0]), 1.0) * lk.w_min ** 4
+    return held + float(np.sum(4.0 * x ** 3 * ee * _GLW_W[None, :] * width[:, None]))
+
+
+def _uniform_lookup(spline: AlbedoTable, grazing, c: int):
+    """Channel *c* of E as a single-level :class:`~brdfkit.tables.UniformLookup`, or None.
+
+    Only for a single-piece table that E never clamps (no kink on [THETA_HOLD, 0°]):
+    a grid uniform in x = √μ anchored at THETA_TOP, where the spline meets the grazing
+    piece, extended below it by whole intervals past THETA_HOLD (below which the read's
+    clamp holds the value); as many intervals as the spline's to start, doubled (at most
+    UNIFORM_MAX_HALVINGS times) until the lookup is within LUT_TOL of E.
+    """
+    if len(spline.piece_nn) != 1:
+        return None
+    x_top = math.sqrt(math.cos(THETA_TOP))
+    x_hold = math.sqrt(math.cos(THETA_HOLD))
+
+    def e_x(x):
+        mu = np.square(np.asarray(x, dtype=np.float64))
+        e = _as_2d(spline.at_cos(np.maximum(mu, mu_of_w(spline.s_top))))[:, c:c + 1].copy()
+        below = x < x_top
+        e[below] = _as_2d(grazing(w_of_mu(mu[below])))[:, c:c + 1]
+        return np.maximum(e, E_FLOOR)  # clamp: see E_FLOOR
+
+    for r in range(UNIFORM_MAX_HALVINGS + 1):
+        n_top = spline.piece_nn[0] << r
+        h = (1.0 - x_top) / n_top
+        n_ext = math.ceil((x_top - x_hold) / h - 1e-9)
+        lk = build_uniform_lookup(e_x, w0=x_top - n_ext * h, h=h, n=n_ext + n_top,
+                                  w_min=x_hold, bound="upper")
+        if lk.max_error <= LUT_TOL:
+            return lk
+    return None
+
+
+def _two_level(spline: AlbedoTable, grazing, c: int, clamped: bool) -> Lookup:
+    """Channel *c* of min(E, 1) as the two-level :class:`~brdfkit.tables.Lookup` (a table
+    of several pieces, or one E crosses 1 on): its kinks are the pieces' boundaries
+    (where the grazing piece meets the table, THETA_TOP), where the value is held
+    (THETA_HOLD) and where E crosses 1 (the clamp)."""
+    ks = np.concatenate([mu_of_w(spline.breaks[:-1]), [math.cos(THETA_HOLD)]])
+    if clamped:
+        grid = np.linspace(0.0, 1.0, 4097)
+        ks = np.concatenate([ks, _crossings(lambda m: _spline_e(
+            spline, grazing, m)[:, c:c + 1] - 1.0, grid, _spline_e(
+            spline, grazing, grid)[:, c:c + 1] - 1.0)])
+
+    def e_of(mu):
+        e = _spline_e(spline, grazing, mu)[:, c:c + 1]
+        return np.clip(e, E_FLOOR, 1.0)  # clamp: see E_FLOOR and the docstring (E > 1)
+    return build_lookup(e_of, kinks=ks, tol=LUT_TOL, bound="upper")
+
+
 def _spline_average(spline: AlbedoTable, grazing) -> np.ndarray:
     """2∫₀¹ min(E, 1) μ dμ of the table and its grazing piece: 64 Gauss–Legendre nodes on
     each piece in w (dμ = 4w(1 − w²) dw), the held value on [0, w(THETA_HOLD)]."""
@@ -263,31 +359,23 @@ def compensation_table(model: BRDF, *, who: str = "compensate") -> CompensationT
             "incidence angle only, which needs an isotropic base (docs/compensation.md, "
             "'Anisotropic bases')")
     t0 = time.perf_counter()
-    spline = build_albedo_table(model, tol=TABLE_TOL, engine_tol=ENGINE_TOL, margin=False,
+    spline = build_albedo_table(model, tol=TABLE_TOL, engine_tol=_engine_tol(model), margin=False,
                                 who=who)
     grazing, grazing_err, _ = _grazing_piece(model, spline)
     max_albedo = np.maximum(spline.max_albedo, np.max(_as_2d(grazing(grazing.x)), axis=0))
     clamped = bool(np.any(max_albedo > 1.0))
-    # the pieces' boundaries (where the grazing piece meets the table, THETA_TOP) and where
-    # the value is held (THETA_HOLD)
-    kinks = np.concatenate([mu_of_w(spline.breaks[:-1]), [math.cos(THETA_HOLD)]])
-    grid = np.linspace(0.0, 1.0, 4097)
-    lookups = []
-    for c in range(max_albedo.size):
-        def e_of(mu, c=c):
-            e = _spline_e(spline, grazing, mu)[:, c:c + 1]
-            return np.clip(e, E_FLOOR, 1.0)  # clamp: see E_FLOOR and the docstring (E > 1)
-        ks = kinks
-        if clamped:  # where E crosses 1, the clamp makes a kink
-            ks = np.concatenate([ks, _crossings(lambda m, c=c: _spline_e(
-                spline, grazing, m)[:, c:c + 1] - 1.0, grid, _spline_e(
-                spline, grazing, grid)[:, c:c + 1] - 1.0)])
-        lookups.append(build_lookup(e_of, kinks=ks, tol=LUT_TOL, bound="upper"))
-    e_avg = np.array([_lookup_average(lk) for lk in lookups])
+    # one kind of lookup for every channel (the kernel reads one): single-level when each
+    # channel's E allows it, else the two-level Lookup
+    lookups = [None if clamped else _uniform_lookup(spline, grazing, c)
+               for c in range(max_albedo.size)]
+    if any(lk is None for lk in lookups):
+        lookups = [_two_level(spline, grazing, c, clamped) for c in range(max_albedo.size)]
+    e_avg = np.array([_uniform_average(lk) if isinstance(lk, UniformLookup)
+                      else _lookup_average(lk) for lk in lookups])
     e_avg_error = np.abs(e_avg - _spline_average(spline, grazing))
     return CompensationTable(
         spline=spline, lookups=tuple(lookups), e_avg=e_avg, e_avg_error=e_avg_error,
         max_albedo=max_albedo, clamped=clamped,
         interp_error=np.maximum(spline.max_midpoint_error, grazing_err),
         lookup_error=float(max(lk.max_error + lk.epsilon for lk in lookups)),
-        engine_tol=ENGINE_TOL, seconds=time.perf_counter() - t0)
+        engine_tol=_engine_tol(model), seconds=time.perf_counter() - t0)

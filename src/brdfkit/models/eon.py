@@ -290,6 +290,8 @@ class EON(StrategySampled, _RoughDiffuse, BRDF):
     the paper's uniform + clipped-LTC mixture (module docstring).
     """
 
+    albedo_engine_tol = 1e-9  # FON's azimuth-90° switch (rough_diffuse._RoughDiffuse)
+
     name = "eon"
     aliases = ("energy-preserving-oren-nayar", "openpbr-diffuse")
     summary = "EON energy-preserving Oren-Nayar: FON + (1-E(mu_i))(1-E(mu_o)) lobe"
