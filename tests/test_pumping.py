@@ -371,7 +371,7 @@ def _reciprocal_cases():
         if not cls.reciprocal or not cls.examples:
             continue
         if not cls(**cls.examples[0]).isotropic:
-            continue  # pump tabulates a(θ): it refuses anisotropic bases (test_pump_refuses_anisotropic)
+            continue  # pump tabulates a(θ), refusing anisotropic bases (test below)
         gs = ("max",) if name in SLOW_MODELS else ("max", "controlled")
         for g in gs:
             yield pytest.param(name, cls.examples[0], g, id=f"{name}-0-{g}")

@@ -12,9 +12,10 @@ Packed row of one channel (``p``): the base's K parameters, then the channel's
 constant at ``p[K]`` (Kulla–Conty: F_ms/(π(1 − E_avg)); Turquin: F₀), then the
 lookup of Ẽ at ``p[K + 1:]`` (padded to the longest channel's): a single-level
 :class:`~brdfkit.tables.UniformLookup` (4 reads) for a table of one smooth piece, else
-the two-level :class:`~brdfkit.tables.Lookup` (8). The lookup is an upper bound of min(E, 1) within its margin; the kernels
-clamp what they read at 1 (:func:`_e`), so 1 − Ẽ ≥ 0 and the compensated albedo
-1 + E − Ẽ never exceeds 1 by the table's error (``docs/compensation.md``).
+the two-level :class:`~brdfkit.tables.Lookup` (8). The lookup is an upper bound of
+min(E, 1) within its margin; the kernels clamp what they read at 1 (:func:`_e`), so
+1 − Ẽ ≥ 0 and the compensated albedo 1 + E − Ẽ never exceeds 1 by the table's error
+(``docs/compensation.md``).
 
 - :func:`kulla_conty_kernel` — f_base + c (1 − Ẽ(μ_i))(1 − Ẽ(μ_o));
 - :func:`turquin_kernel` — f_base (1 + F₀ (1 − Ẽ(μ_i))/Ẽ(μ_i)).
