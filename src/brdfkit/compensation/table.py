@@ -165,7 +165,7 @@ class CompensationTable:
     @property
     def message(self) -> str:
         """One line with the table's accuracy."""
-        clamp = (f"; E reaches {float(np.max(self.max_albedo)):.6g} > 1 and is clamped at 1"
+        clamp = (f"; E reaches {float(np.max(self.max_albedo)):.9g} > 1 and is clamped at 1"
                  if self.clamped else "")
         return (f"E(mu) tabulated on {self.spline.n_intervals} intervals: max midpoint error "
                 f"{float(np.max(self.interp_error)):.2g}, lookup {self.lookup_error:.2g}, "
