@@ -131,6 +131,7 @@ from brdfkit.halfangle import beta_from_trowbridge_reitz_c
 from brdfkit.models._base import BRDF, VECTOR_OPTIONS, Lobe, Param
 from brdfkit.models._drivers import loop_driver
 from brdfkit.models._registry import register
+from brdfkit.models.microfacet import reflection_jacobian
 from brdfkit.models.sampling import Strategy, StrategySampled
 
 __all__ = ["Disney", "principled", "disney_sample", "disney_pdf", "mixture_weights",
@@ -386,21 +387,13 @@ def disney_pdf(ix, iy, iz, ox, oy, oz, ax, ay, a2cc, w_d, s0, cc4):
     as it is (h_z ≤ 0: never sampled, density 0); 0 when ω_o is at or below the horizon
     or ω_i = −ω_o."""
     p_d, p_s, p_c = mixture_weights(oz, w_d, s0, cc4)
-    hx = ix + ox
-    hy = iy + oy
-    hz = iz + oz
-    norm = sqrt(hx * hx + hy * hy + hz * hz)
-    ok = norm > 0.0
-    n = select(ok, norm, 1.0)  # 1: keep the discarded lane finite
-    hx = hx / n
-    hy = hy / n
-    hz = hz / n
-    cos_oh = ox * hx + oy * hy + oz * hz
-    ok = ok & (hz > 0.0) & (cos_oh > 0.0) & (oz > 0.0)
+    hx, hy, hz, ok, jac = reflection_jacobian(ix, iy, iz, ox, oy, oz)
+    # the samplers only draw h with h_z > 0 and ω_o·h > 0 (where jac = 4 ω_o·h)
+    ok = ok & (hz > 0.0) & (ox * hx + oy * hy + oz * hz > 0.0)
     t = hx * hx / (ax * ax) + hy * hy / (ay * ay) + hz * hz
     d_s = 1.0 / (PI * ax * ay * (t * t))
     d_r = (a2cc - 1.0) / (PI * log(a2cc) * (hx * hx + hy * hy + a2cc * hz * hz))
-    half = (p_s * d_s + p_c * d_r) * hz / (4.0 * select(ok, cos_oh, 1.0))
+    half = (p_s * d_s + p_c * d_r) * hz / jac
     return select(oz > 0.0, p_d * maximum(iz, 0.0) * INV_PI + select(ok, half, 0.0), 0.0)
 
 
