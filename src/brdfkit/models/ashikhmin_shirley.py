@@ -93,6 +93,7 @@ from brdfkit.models.sampling import (
     HalfVectorDistribution,
     Mixture,
     StrategySampled,
+    malley,
 )
 
 __all__ = ["AshikhminShirley", "AshikhminShirleyHalf", "ashikhmin_shirley", "as_sample",
@@ -203,13 +204,11 @@ def as_sample(ox, oy, oz, u0, u1, nu, nv, w_d):
     pick_cos = u0 < w_d
     uc = minimum(u0 / maximum(w_d, 1e-30), 1.0)  # floor: w_d = 0 (never picked), clamp: rounding
     us = maximum((u0 - w_d) / maximum(1.0 - w_d, 1e-30), 0.0)  # floor: w_d = 1 (never picked)
-    r = sqrt(uc)  # Malley: a uniform point of the disk lifted to the hemisphere
-    phi = TWO_PI * u1
-    cz = sqrt(maximum(1.0 - uc, 0.0))  # clamp: rounding at the rim
+    cx, cy, cz = malley(uc, u1)
     hx, hy, hz = as_half(us, u1, nu, nv)
     c = 2.0 * (ox * hx + oy * hy + oz * hz)
-    return (select(pick_cos, r * cos(phi), c * hx - ox),
-            select(pick_cos, r * sin(phi), c * hy - oy), select(pick_cos, cz, c * hz - oz))
+    return (select(pick_cos, cx, c * hx - ox),
+            select(pick_cos, cy, c * hy - oy), select(pick_cos, cz, c * hz - oz))
 
 
 @formula

@@ -132,7 +132,7 @@ from brdfkit.models._base import BRDF, VECTOR_OPTIONS, Lobe, Param
 from brdfkit.models._drivers import loop_driver
 from brdfkit.models._registry import register
 from brdfkit.models.microfacet import reflection_jacobian
-from brdfkit.models.sampling import Strategy, StrategySampled
+from brdfkit.models.sampling import Strategy, StrategySampled, malley
 
 __all__ = ["Disney", "principled", "disney_sample", "disney_pdf", "mixture_weights",
            "HK_SUM_FLOOR"]
@@ -365,12 +365,7 @@ def disney_sample(ox, oy, oz, u0, u1, ax, ay, a2cc, w_d, s0, cc4):
     ud = minimum(u0 / maximum(p_d, 1e-300), 1.0)  # 1e-300: p_d = 0 is never picked
     us = minimum(maximum((u0 - p_d) / p_s, 0.0), 1.0)  # p_s > 0 always; clamps: rounding
     uc = minimum(maximum((u0 - p_d - p_s) / maximum(p_c, 1e-300), 0.0), 1.0)
-    # Malley: a uniform point of the unit disk lifted to the hemisphere (pdf cos θ/π)
-    rd = sqrt(ud)
-    phi = TWO_PI * u1
-    dx = rd * cos(phi)
-    dy = rd * sin(phi)
-    dz = sqrt(maximum(1.0 - ud, 0.0))  # clamp: rounding at the rim
+    dx, dy, dz = malley(ud, u1)
     hx, hy, hz = gtr2_half(us, u1, ax, ay)
     sx, sy, sz = _reflect(ox, oy, oz, hx, hy, hz)
     kx, ky, kz = gtr1_half(uc, u1, a2cc)

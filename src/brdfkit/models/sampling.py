@@ -54,11 +54,13 @@ References
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from brdfkit._array import as_directions, as_uniform, stack
+from brdfkit._dual import cos, formula, maximum, sin, sqrt
 from brdfkit.geometry import (
     local_to_world,
     pdf_cosine_hemisphere,
@@ -420,3 +422,15 @@ def log_mixture_weights(logw: Sequence[np.ndarray]) -> np.ndarray:
     w = np.where(none, np.eye(logw.shape[-1])[0], w)
     return w / np.sum(w, axis=-1, keepdims=True)
 
+
+_TWO_PI = 2.0 * math.pi  # a module constant: formulas read no attributes (brdfkit._dual)
+
+
+@formula
+def malley(u0, u1):
+    """Malley's method as a formula (:mod:`brdfkit._dual`): a uniform point of the unit disk,
+    radius √u₀ and angle 2πu₁, lifted to the hemisphere (density cos θ/π); the cosine
+    component of the formula samplers (Disney, Ashikhmin–Shirley, the user models' proxy)."""
+    r = sqrt(u0)
+    phi = _TWO_PI * u1
+    return r * cos(phi), r * sin(phi), sqrt(maximum(1.0 - u0, 0.0))  # clamp: rounding at the rim

@@ -79,11 +79,11 @@ import math
 
 import numpy as np
 
-from brdfkit._dual import Formulas, cos, formula, maximum, minimum, select, sin, sqrt
+from brdfkit._dual import Formulas, formula, maximum, minimum, select
 from brdfkit.errors import ParameterError
 from brdfkit.halfangle import trowbridge_reitz_c_from_beta
 from brdfkit.models.microfacet import walter_pdf, walter_sample
-from brdfkit.models.sampling import Strategy
+from brdfkit.models.sampling import Strategy, malley
 from brdfkit.user._loops import sampler_loops
 from brdfkit.user.model import SamplerFormulas
 
@@ -101,7 +101,6 @@ ALPHA_DIFFUSE = 1.0
 #: Largest half-width converted: D₃'s half-angle exists for β < π/2 only (α → 2^(−1/4)).
 _BETA_MAX = 0.5 * math.pi - 1e-6
 INV_PI = 1.0 / math.pi
-TWO_PI = 2.0 * math.pi
 #: Floor of the GGX component's weight 1 − w_c as a divisor: w_c = 1 rescales u₀ to
 #: −inf/… in the discarded GGX lane, then clamped to 0 (finite); 1e-30 is a normal
 #: float32 number, so the floor holds in Mitsuba's single-precision variants too.
@@ -142,12 +141,7 @@ def proxy_sample(ox, oy, oz, u0, u1, alpha, w_c):
     pick_cos = u0 < w_c
     uc = minimum(u0 / w_c, 1.0)  # clamp: rounding of the rescaled u₀
     ug = maximum((u0 - w_c) / maximum(1.0 - w_c, _TINY), 0.0)  # ≥ 0: see _TINY
-    # Malley: a uniform point of the unit disk lifted to the hemisphere (pdf cos θ/π)
-    r = sqrt(uc)
-    phi = TWO_PI * u1
-    cx = r * cos(phi)
-    cy = r * sin(phi)
-    cz = sqrt(maximum(1.0 - uc, 0.0))  # clamp: rounding at the rim
+    cx, cy, cz = malley(uc, u1)
     gx, gy, gz = walter_sample(ox, oy, oz, ug, u1, alpha, True)
     return select(pick_cos, cx, gx), select(pick_cos, cy, gy), select(pick_cos, cz, gz)
 
