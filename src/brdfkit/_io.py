@@ -4,16 +4,21 @@ Every file brdfkit writes (figures, MERL tables, renders, fit results) goes
 through :func:`write_atomic`: the bytes go to a temporary file in the target
 directory, which is renamed over the target with :func:`os.replace` (atomic on
 POSIX), and removed again on any error or interruption. Errors name the path
-and what is wrong with it. :func:`to_jsonable` makes any result JSON-ready in
-one way for every writer of JSON (the CLI's ``--json``, the explorer's API):
-NumPy values to Python types, NaN and ±inf to null.
+and what is wrong with it. A process killed outright (SIGKILL, power loss) cannot
+remove its temporary file; the name carries the writer's process id
+(``.brdfkit-<pid>-XXXXXXXX<suffix>``), and the first write of a later process into the
+same directory removes those whose writer is gone (:func:`remove_stale_temp_files`).
+:func:`to_jsonable` makes any result JSON-ready in one way for every writer of JSON
+(the CLI's ``--json``, the explorer's API): NumPy values to Python types, NaN and ±inf to null.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import re
 import tempfile
+import time
 from collections.abc import Callable, Mapping
 from typing import BinaryIO
 
@@ -21,7 +26,17 @@ import numpy as np
 
 from brdfkit.errors import BrdfkitError
 
-__all__ = ["write_atomic", "check_output_path", "to_jsonable"]
+__all__ = ["write_atomic", "check_output_path", "to_jsonable", "remove_stale_temp_files",
+           "TEMP_PREFIX"]
+
+#: The start of every temporary file's name; then the writer's pid, '-', mkstemp's 8 random
+#: characters (letters, digits, '_') and the target's suffix.
+TEMP_PREFIX = ".brdfkit-"
+_TEMP_NAME = re.compile(r"\.brdfkit-(?:(?P<pid>\d+)-)?[a-z0-9_]{8}(?:\.[A-Za-z0-9]+)?")
+#: A temporary file without a pid (written before the pid was in the name) is stale when
+#: it is older than this: no write of brdfkit takes an hour between creating and renaming.
+UNTAGGED_STALE_SECONDS = 3600.0
+_CLEANED: set[str] = set()  # directories this process has cleaned
 
 
 def check_output_path(path, *, option: str = "path", suffixes: tuple[str, ...] = ()) -> str:
@@ -52,7 +67,7 @@ def check_output_path(path, *, option: str = "path", suffixes: tuple[str, ...] =
 def write_atomic(path, write: Callable[[BinaryIO], None], *, option: str = "path") -> str:
     """Call ``write(fh)`` on a temporary file next to *path*, then rename it to *path*.
 
-    The temporary file is ``.brdfkit-XXXX<suffix>`` in the target directory, so
+    The temporary file is ``.brdfkit-<pid>-XXXXXXXX<suffix>`` in the target directory, so
     *path* is either the old file or the complete new one. It gets the mode a
     plain ``open()`` would give it (the umask applied to 0o666; ``mkstemp`` would
     leave 0o600). On any exception — including KeyboardInterrupt and SystemExit
@@ -63,9 +78,12 @@ def write_atomic(path, write: Callable[[BinaryIO], None], *, option: str = "path
     """
     p = check_output_path(path, option=option)
     directory = os.path.dirname(os.path.abspath(p))
+    if directory not in _CLEANED:
+        _CLEANED.add(directory)
+        remove_stale_temp_files(directory)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=".brdfkit-", suffix=os.path.splitext(p)[1],
-                                   dir=directory)
+        fd, tmp = tempfile.mkstemp(prefix=f"{TEMP_PREFIX}{os.getpid()}-",
+                                   suffix=os.path.splitext(p)[1], dir=directory)
     except OSError as exc:
         raise BrdfkitError(f"{option} {p!r}: cannot create a file in {directory!r} "
                            f"({exc.strerror or exc}); choose a writable directory") from None
@@ -84,6 +102,48 @@ def write_atomic(path, write: Callable[[BinaryIO], None], *, option: str = "path
                                f"({exc.strerror or exc})") from None
         raise
     return p
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process: alive
+        return True
+    except OverflowError:  # not a pid at all
+        return False
+    return True
+
+
+def remove_stale_temp_files(directory) -> list[str]:
+    """Remove brdfkit's own temporary files in *directory* (not below it) that no process
+    is writing any more: those whose writer's pid (in the name) is gone, and untagged ones
+    older than :data:`UNTAGGED_STALE_SECONDS`. Files of other names are never touched;
+    errors (a file removed meanwhile, no permission) are ignored. Returns the removed paths.
+    """
+    removed = []
+    try:
+        names = os.listdir(directory)
+    except OSError:
+        return removed
+    now = time.time()
+    for name in names:
+        m = _TEMP_NAME.fullmatch(name)
+        if m is None:
+            continue
+        path = os.path.join(directory, name)
+        try:
+            if m["pid"] is not None:
+                stale = int(m["pid"]) != os.getpid() and not _alive(int(m["pid"]))
+            else:
+                stale = now - os.lstat(path).st_mtime > UNTAGGED_STALE_SECONDS
+            if stale and os.path.isfile(path) and not os.path.islink(path):
+                os.unlink(path)
+                removed.append(path)
+        except OSError:
+            continue
+    return removed
 
 
 def to_jsonable(obj):

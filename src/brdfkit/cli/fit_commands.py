@@ -19,8 +19,10 @@ import click
 
 import brdfkit.cli._progress as _progress
 from brdfkit.cli._common import COMPENSATE_HELP, PARAM_HELP, emit_json
+from brdfkit.cli._group import OneLineError, one_line
 from brdfkit.errors import BrdfkitError
 from brdfkit.fitting import LOSSES, PROCEDURES  # the registries' names (--loss, --procedure)
+from brdfkit.fitting.batch import CONNECT_TIMEOUT_S
 from brdfkit.spec import COMPENSATE_CHOICES, PUMP_CHOICES, ModelSpec, canonical_name, parse_items
 
 __all__ = ["fit_cmd"]
@@ -62,9 +64,11 @@ __all__ = ["fit_cmd"]
                    "pyarrow), written atomically as each finishes; re-running resumes "
                    "(finished rows are skipped).")
 @click.option("--workers", type=click.IntRange(1, 256), default=1, show_default=True,
-              help="Batch: local worker processes.")
+              help="Batch: local worker processes (at most one per CPU and per fit: more "
+                   "are capped, with a note).")
 @click.option("--scheduler", default=None, metavar="ADDRESS",
-              help="Batch: run on this Dask distributed scheduler (tcp://host:8786) instead.")
+              help="Batch: run on this Dask distributed scheduler (tcp://HOST:PORT) instead; "
+                   f"it must answer within {CONNECT_TIMEOUT_S:g} s.")
 def fit_cmd(models, param, start, compensate, pump, times, to, loss, procedure, seed, starts,
             theta_max, as_json, plot, out, workers, scheduler):
     """Fit MODEL's parameters to a measured material (-p NAME=VALUE holds a parameter,
@@ -76,7 +80,9 @@ def fit_cmd(models, param, start, compensate, pump, times, to, loss, procedure, 
     Batch: several MODELs and/or materials, with --out FILE.csv, e.g.
     brdfkit fit modified-phong nielsen --to merl:all --out fits.csv --workers 2
     (--scheduler ADDRESS runs the same batch on a Dask cluster). A progress bar
-    shows on a terminal; Ctrl-C keeps every finished row; re-run to resume.
+    shows on a terminal; Ctrl-C keeps every finished row; re-run to resume. Exit
+    status 1 when fits failed (their rows say why; a re-run retries them), 2 for bad
+    input (an --out another batch is writing, a foreign file, an unreachable scheduler).
     """
     from brdfkit.fitting.batch import expand_targets
 
@@ -166,6 +172,39 @@ def _batch(models, targets, *, param, start, pump, times, loss, procedure, seed,
     show = _progress.stderr_is_interactive()
     with _progress.counter("fit", enabled=show) as progress:
         report = run_batch(jobs, out=out, run_job=fit_row, workers=workers,
-                           scheduler=scheduler, progress=progress)
+                           scheduler=scheduler, progress=progress, notice=_note)
+    nc = f"{report.not_converged} not converged, " if report.not_converged else ""
     click.echo(f"{report.out}: {report.done} fitted now, {report.skipped} already there, "
-               f"{report.failed} failed, of {report.total} ({report.seconds:.1f} s)")
+               f"{nc}{report.failed} failed, of {report.total} ({report.seconds:.1f} s)")
+    if report.failed:
+        raise BatchFailed(_failed_message(report))
+
+
+#: Exit status of a batch that ran to its end with failed rows (bad input is 2, as for
+#: every command; a signal 128 + its number).
+EXIT_BATCH_FAILED = 1
+#: Failed rows whose reasons the error line quotes (the file has them all).
+_SHOWN_FAILURES = 3
+#: Characters of each quoted reason.
+_REASON_CHARS = 160
+
+
+class BatchFailed(OneLineError):
+    """A batch with failed rows: one line ``brdfkit: error: N of M fits failed ...``,
+    exit status :data:`EXIT_BATCH_FAILED`."""
+
+    exit_code = EXIT_BATCH_FAILED
+
+
+def _failed_message(report) -> str:
+    reasons = "; ".join(one_line(f)[:_REASON_CHARS] for f in report.failures[:_SHOWN_FAILURES])
+    more = (f"; and {report.failed - _SHOWN_FAILURES} more"
+            if report.failed > _SHOWN_FAILURES else "")
+    return (f"{report.failed} of {report.total} fits failed ({reasons}{more}); every "
+            f"message is in the status and message columns of {report.out}; re-run the "
+            "same command to retry the failed ones")
+
+
+def _note(message: str) -> None:
+    """What the batch changed on its own (workers capped, invalid rows), one line on stderr."""
+    click.echo(f"brdfkit: note: {one_line(message)}", err=True)

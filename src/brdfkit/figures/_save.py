@@ -55,7 +55,7 @@ def save_atomic(fig, path, *, dpi: int = 150, option: str = "path") -> str:
     Written through :func:`brdfkit._io.write_atomic`: *path* is either the old
     file or the complete new one, and any exception — including
     :class:`SystemExit` raised by the command line's SIGTERM handler — removes
-    the temporary ``.brdfkit-XXXX.<ext>`` file before it propagates.
+    the temporary ``.brdfkit-<pid>-XXXXXXXX.<ext>`` file before it propagates.
 
     Parameters
     ----------

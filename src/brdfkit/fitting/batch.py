@@ -45,29 +45,41 @@ Public objects
 from __future__ import annotations
 
 import concurrent.futures as cf
-import csv
-import io
+import ctypes
 import multiprocessing
 import os
+import signal
+import sys
+import threading
 import time
 import traceback
+import warnings
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
-from brdfkit._io import check_output_path, write_atomic
+from brdfkit._io import check_output_path
 from brdfkit.errors import BrdfkitError
+from brdfkit.fitting._batchfile import (
+    KEY_COLUMNS,
+    STATUS_ERROR,
+    STATUS_NOT_CONVERGED,
+    STATUS_OK,
+    SUFFIXES,
+    describe_invalid,
+    is_parquet,
+    key_of,
+    pyarrow_modules,
+    read_checked,
+    read_rows,
+    write_rows,
+    writer_lock,
+)
+from brdfkit.fitting._dask import CONNECT_TIMEOUT_S
 
-__all__ = ["Job", "run_batch", "BatchReport", "BatchInterrupted", "read_rows", "write_rows",
-           "SUFFIXES",
+__all__ = ["Job", "run_batch", "BatchReport", "BatchInterrupted", "read_rows", "read_checked",
+           "write_rows", "SUFFIXES", "useful_workers", "MAX_WORKERS", "CONNECT_TIMEOUT_S",
            "fit_row", "job_spec", "expand_targets", "KEY_COLUMNS", "STATUS_OK", "STATUS_ERROR",
            "STATUS_NOT_CONVERGED"]
-
-#: Columns that identify a job's row (its key), first in every output file.
-KEY_COLUMNS = ("model", "target", "loss", "procedure")
-STATUS_OK = "ok"
-STATUS_ERROR = "error"
-#: A fit that ran but did not converge (its FitResult.success is False): kept, not retried.
-STATUS_NOT_CONVERGED = "not-converged"
 
 
 @dataclass(frozen=True)
@@ -92,7 +104,10 @@ class Job:
 @dataclass
 class BatchReport:
     """What a batch did: jobs ``total``, ``skipped`` (already in the file), ``done``
-    (finished now, ok or error), ``failed`` (status error), ``seconds``, the output path."""
+    (finished now: ok, not converged or error), ``failed`` (status error now),
+    ``not_converged``, ``seconds``, the output path, ``failures`` (``"target (model):
+    message"`` of each failed row, in order), ``invalid`` (rows of the file left out on
+    reading, each with its line and reason), ``workers`` (local processes used)."""
 
     total: int
     skipped: int
@@ -100,6 +115,10 @@ class BatchReport:
     failed: int
     seconds: float
     out: str
+    not_converged: int = 0
+    failures: list = field(default_factory=list)
+    invalid: list = field(default_factory=list)
+    workers: int = 1
 
     @property
     def success(self) -> bool:
@@ -108,113 +127,6 @@ class BatchReport:
 
 class BatchInterrupted(BrdfkitError):
     """The batch was interrupted (Ctrl-C); every finished row is in the output file."""
-
-
-# --------------------------------------------------------------------------- the file
-def _key_of(row: dict) -> tuple:
-    return tuple(str(row.get(c, "")) for c in KEY_COLUMNS)
-
-
-#: Suffixes of batch output files: CSV (always) and Parquet (with pyarrow).
-SUFFIXES = (".csv", ".parquet")
-
-
-def _is_parquet(path) -> bool:
-    return os.fspath(path).lower().endswith(".parquet")
-
-
-def _pyarrow(path):
-    try:
-        import pyarrow
-        import pyarrow.parquet
-    except ImportError:
-        raise BrdfkitError(f"--out {os.fspath(path)!r}: Parquet output needs pyarrow: pip "
-                           "install 'brdfkit[batch]' (or pip install pyarrow), or write "
-                           ".csv") from None
-    return pyarrow, pyarrow.parquet
-
-
-def _check_columns(p, names) -> None:
-    missing = [c for c in (*KEY_COLUMNS, "status") if c not in (names or ())]
-    if missing:
-        raise BrdfkitError(f"{p}: not a brdfkit batch file: expected columns "
-                           f"{', '.join((*KEY_COLUMNS, 'status'))}; missing "
-                           f"{', '.join(missing)} (choose another --out to start afresh)")
-
-
-def read_rows(path) -> list[dict]:
-    """Rows of a batch output file, [] if it does not exist: from CSV as dicts of strings,
-    from Parquet with the stored types (None where a row has no value).
-
-    Raises :class:`~brdfkit.errors.BrdfkitError` naming the file when it exists
-    but is not a batch file (no key columns, or not readable as Parquet)."""
-    p = os.fspath(path)
-    if not os.path.exists(p):
-        return []
-    if _is_parquet(p):
-        _, pq = _pyarrow(p)
-        try:
-            table = pq.read_table(p)
-        except (OSError, ValueError) as exc:  # pyarrow's ArrowInvalid is a ValueError
-            raise BrdfkitError(f"{p}: not a Parquet file ({exc}); choose another --out to "
-                               "start afresh") from None
-        _check_columns(p, table.column_names)
-        return table.to_pylist()
-    with open(p, newline="", encoding="utf-8") as fh:
-        reader = csv.DictReader(fh)
-        _check_columns(p, reader.fieldnames)
-        return list(reader)
-
-
-def _column_type(pa, values):
-    """One Arrow type for a column: bool, int64 or float64 (ints and floats mixed) when
-    every value present is of that kind, else string (values written with str())."""
-    present = [v for v in values if v is not None]
-    if present and all(isinstance(v, bool) for v in present):
-        return pa.bool_()
-    if present and all(isinstance(v, int) and not isinstance(v, bool) for v in present):
-        return pa.int64()
-    if present and all(isinstance(v, int | float) and not isinstance(v, bool)
-                       for v in present):
-        return pa.float64()
-    return pa.string()
-
-
-def _write_parquet(path, rows, columns) -> str:
-    pa, pq = _pyarrow(path)
-    arrays = []
-    for c in columns:
-        vals = [r.get(c) for r in rows]
-        kind = _column_type(pa, vals)
-        if kind == pa.string():
-            vals = [None if v is None else str(v) for v in vals]
-        elif kind == pa.float64():
-            vals = [None if v is None else float(v) for v in vals]
-        arrays.append(pa.array(vals, type=kind))
-    table = pa.Table.from_arrays(arrays, names=list(columns))
-    return write_atomic(path, lambda fh: pq.write_table(table, fh), option="--out")
-
-
-def write_rows(path, rows: Iterable[dict]) -> str:
-    """Write *rows* atomically as CSV or, for a ``.parquet`` path, Parquet (one typed
-    column per field: bool, int64, float64 or string): key columns and status first, then
-    the others in order of first appearance."""
-    rows = list(rows)
-    columns = [*KEY_COLUMNS, "status"]
-    for r in rows:
-        columns.extend(c for c in r if c not in columns)
-    if _is_parquet(path):
-        return _write_parquet(path, rows, columns)
-
-    def write(fh):
-        text = io.StringIO()
-        w = csv.DictWriter(text, fieldnames=columns, restval="", lineterminator="\n")
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: ("" if v is None else v) for k, v in r.items()})
-        fh.write(text.getvalue().encode("utf-8"))
-
-    return write_atomic(path, write, option="--out")
 
 
 # --------------------------------------------------------------------------- running
@@ -233,16 +145,56 @@ def _safe(run_job: Callable[[Job], dict], job: Job) -> dict:
     return row
 
 
+def _error_row(job: Job, message: str) -> dict:
+    return {**dict(zip(KEY_COLUMNS, job.key, strict=True)), "status": STATUS_ERROR,
+            "message": message}
+
+
+#: Most local worker processes (a sanity bound on the argument; the CPUs cap it further).
+MAX_WORKERS = 256
+
+
 def _check_workers(workers) -> int:
-    ok = isinstance(workers, int) and not isinstance(workers, bool) and 1 <= workers <= 256
+    ok = isinstance(workers, int) and not isinstance(workers, bool) and \
+        1 <= workers <= MAX_WORKERS
     if not ok:
-        raise BrdfkitError(f"--workers must be an integer from 1 to 256; got {workers!r}")
+        raise BrdfkitError(f"--workers must be an integer from 1 to {MAX_WORKERS}; got "
+                           f"{workers!r}")
     return workers
+
+
+def _cpus() -> int:
+    """CPUs this process may run on (its affinity mask where the system has one)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        return os.cpu_count() or 1
+
+
+def useful_workers(workers: int, n_jobs: int) -> tuple[int, str]:
+    """The processes worth starting for *n_jobs* jobs: at most one per CPU (a fit keeps
+    a CPU busy; more processes only compete for it and each costs an interpreter, Numba
+    and the data) and one per job. Returns the number and, when the CPUs capped
+    *workers*, one line saying so ('' otherwise)."""
+    cpus = _cpus()
+    n = max(1, min(workers, cpus, n_jobs))
+    if workers > cpus and n_jobs > cpus:
+        return n, (f"--workers {workers} capped at {n}: this machine has {cpus} CPU(s) for "
+                   "this process, and more processes than CPUs only compete for them")
+    return n, ""
+
+
+def _say(notice, message: str) -> None:
+    if notice is not None:
+        notice(message)
+    else:
+        warnings.warn(message, stacklevel=3)
 
 
 def run_batch(jobs: Iterable[Job], *, out, run_job: Callable[[Job], dict], workers: int = 1,
               scheduler=None, retries: int = 2,
-              progress: Callable[[int, int, str], None] | None = None) -> BatchReport:
+              progress: Callable[[int, int, str], None] | None = None,
+              notice: Callable[[str], None] | None = None) -> BatchReport:
     """Run *jobs* with *run_job*, writing each finished row to *out* (module docstring).
 
     Parameters
@@ -251,17 +203,21 @@ def run_batch(jobs: Iterable[Job], *, out, run_job: Callable[[Job], dict], worke
         Duplicates (same key) run once.
     out : path
         CSV or Parquet output (by suffix); existing ok rows are kept and their jobs
-        skipped.
+        skipped; invalid rows are left out and their jobs run again.
     run_job : callable
         ``run_job(job) -> dict`` (module level, importable by the workers).
     workers : int, keyword-only
-        Local processes, 1 to 256 (1: in this process). Ignored with *scheduler*.
+        Local processes, 1 to 256 (1: in this process), capped at the CPUs and the jobs
+        (:func:`useful_workers`). Ignored with *scheduler*.
     scheduler : str or distributed.Client or LocalCluster, keyword-only, optional
-        Run on this Dask cluster instead.
+        Run on this Dask cluster instead (``tcp://HOST:PORT``).
     retries : int, keyword-only
         Dask retries of a job whose worker died (0 to 10).
     progress : callable, keyword-only, optional
         ``progress(done, total, label)`` after each finished job and once at the start.
+    notice : callable, keyword-only, optional
+        ``notice(line)`` for what the batch changed on its own: workers capped, invalid
+        rows left out. Default: :func:`warnings.warn`.
 
     Returns
     -------
@@ -272,103 +228,126 @@ def run_batch(jobs: Iterable[Job], *, out, run_job: Callable[[Job], dict], worke
     BatchInterrupted
         On KeyboardInterrupt, after cancelling the pending jobs; finished rows are on disk.
     BrdfkitError
-        Bad *out*, *workers* or *retries*; an unreachable scheduler.
+        Bad *out* (not a batch file, written by another batch now), *workers*, *retries*
+        or *scheduler*; an unreachable scheduler; a scheduler that went away.
     """
     path = check_output_path(out, option="--out", suffixes=SUFFIXES)
-    if _is_parquet(path):
-        _pyarrow(path)  # fail before any fit when pyarrow is missing
+    if is_parquet(path):
+        pyarrow_modules(path)  # fail before any fit when pyarrow is missing
     workers = _check_workers(workers)
     if not (isinstance(retries, int) and 0 <= retries <= 10):
         raise BrdfkitError(f"retries must be an integer from 0 to 10; got {retries!r}")
+    if isinstance(scheduler, str):
+        from brdfkit.fitting._dask import check_address
+
+        check_address(scheduler)  # a malformed address fails before anything else
+    with writer_lock(path):
+        return _run_locked(list(jobs), path, run_job=run_job, workers=workers,
+                           scheduler=scheduler, retries=retries, progress=progress,
+                           notice=notice)
+
+
+def _run_locked(jobs, path, *, run_job, workers, scheduler, retries, progress, notice):
     unique = list({j.key: j for j in jobs}.values())
-    rows = {_key_of(r): r for r in read_rows(path)}
+    valid, invalid = read_checked(path)
+    if invalid:
+        _say(notice, describe_invalid(path, invalid))
+    rows = {key_of(r): r for r in valid}
     finished = {k for k, r in rows.items()
                 if r.get("status") in (STATUS_OK, STATUS_NOT_CONVERGED)}
     todo = [j for j in unique if j.key not in finished]
     total, skipped = len(unique), len(unique) - len(todo)
+    if invalid and not todo:
+        write_rows(path, rows.values())  # nothing to run: still drop the invalid rows
+    n_workers = 1
+    if scheduler is None and workers > 1 and len(todo) > 1:
+        n_workers, why = useful_workers(workers, len(todo))
+        if why:
+            _say(notice, why)
     t0 = time.perf_counter()
-    state = {"done": 0, "failed": 0}
+    state = {"done": 0, "failed": 0, "not_converged": 0}
+    failures: list[str] = []
 
     def record(row: dict) -> None:
-        rows[_key_of(row)] = row
+        rows[key_of(row)] = row
         write_rows(path, rows.values())
         state["done"] += 1
-        state["failed"] += row.get("status") != STATUS_OK
+        if row.get("status") == STATUS_ERROR:
+            state["failed"] += 1
+            failures.append(f"{row['target']} ({row['model']}): {row.get('message', '')}")
+        state["not_converged"] += row.get("status") == STATUS_NOT_CONVERGED
         if progress is not None:
             progress(skipped + state["done"], total, f"{row['model']} -> {row['target']}")
+
+    def where() -> str:
+        return f"{skipped + state['done']} of {total} rows are in {path}"
 
     if progress is not None:
         progress(skipped, total, "")
     try:
         if scheduler is not None:
-            _run_dask(todo, run_job, scheduler, retries, record)
-        elif workers == 1 or len(todo) <= 1:
+            from brdfkit.fitting._dask import run_dask
+
+            run_dask(todo, run_job=run_job, scheduler=scheduler, retries=retries,
+                     record=record, safe=_safe, error_row=_error_row, where=where)
+        elif n_workers == 1:
             for job in todo:
                 record(_safe(run_job, job))
         else:
-            _run_processes(todo, run_job, workers, record)
+            _run_processes(todo, run_job, n_workers, record)
     except KeyboardInterrupt:
-        raise BatchInterrupted(
-            f"interrupted: {skipped + state['done']} of {total} rows are in {path}; re-run the "
-            "same command to resume") from None
+        raise BatchInterrupted(f"interrupted: {where()}; re-run the same command to "
+                               "resume") from None
     return BatchReport(total=total, skipped=skipped, done=state["done"],
-                       failed=state["failed"], seconds=time.perf_counter() - t0, out=path)
+                       failed=state["failed"], seconds=time.perf_counter() - t0, out=path,
+                       not_converged=state["not_converged"], failures=failures,
+                       invalid=invalid, workers=n_workers)
+
+
+#: prctl(2) option: the signal the kernel sends this process when its parent dies
+#: (<linux/prctl.h>).
+_PR_SET_PDEATHSIG = 1
+#: Seconds between a worker's checks that its parent lives, where prctl is missing.
+_PARENT_POLL_S = 1.0
+
+
+def _die_with_parent(parent: int) -> None:
+    """A worker process's initializer: end this process when the batch's process dies,
+    even by SIGKILL, which runs no cleanup of its own (the workers, and with them the
+    multiprocessing resource tracker, were left running under PID 1). Linux: the kernel
+    does it (``prctl(PR_SET_PDEATHSIG, SIGKILL)``); elsewhere a daemon thread polls the
+    parent's pid."""
+    armed = False
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            armed = libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
+        except (OSError, AttributeError):
+            armed = False
+    if os.getppid() != parent:  # the parent died before we were armed
+        os._exit(1)
+    if not armed:
+        def watch() -> None:
+            while os.getppid() == parent:
+                time.sleep(_PARENT_POLL_S)
+            os._exit(1)
+
+        threading.Thread(target=watch, name="brdfkit-parent-watch", daemon=True).start()
 
 
 def _run_processes(todo, run_job, workers, record) -> None:
     ctx = multiprocessing.get_context("spawn")
-    pool = cf.ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=ctx)
+    pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                                  initializer=_die_with_parent, initargs=(os.getpid(),))
     try:
         futures = {pool.submit(_safe, run_job, j): j for j in todo}
         for fut in cf.as_completed(futures):
             try:
                 record(fut.result())
             except cf.process.BrokenProcessPool as exc:  # a worker process died
-                j = futures[fut]
-                record({**dict(zip(KEY_COLUMNS, j.key, strict=True)), "status": STATUS_ERROR,
-                        "message": f"worker process died: {exc}"})
+                record(_error_row(futures[fut], f"worker process died: {exc}"))
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
-
-
-def _client(scheduler):
-    try:
-        import distributed
-    except ImportError:
-        raise BrdfkitError("--scheduler needs Dask distributed: pip install 'brdfkit[batch]' "
-                           "(or pip install distributed)") from None
-    if isinstance(scheduler, distributed.Client):
-        return scheduler, False
-    try:
-        return distributed.Client(scheduler, timeout="10s", set_as_default=False), True
-    except (OSError, TimeoutError) as exc:
-        raise BrdfkitError(f"--scheduler {scheduler!r}: cannot connect to a Dask scheduler "
-                           f"({exc}); start one with 'dask scheduler' or check the "
-                           "address") from None
-
-
-def _run_dask(todo, run_job, scheduler, retries, record) -> None:
-    from distributed import as_completed
-
-    client, own = _client(scheduler)
-    try:
-        job_of = {client.submit(_safe, run_job, j, pure=False, retries=retries,
-                                key=f"brdfkit-fit-{'|'.join(j.key)}-{os.getpid()}-{k}"): j
-                  for k, j in enumerate(todo)}
-        futures = list(job_of)
-        try:
-            for fut, row in as_completed(futures, with_results=True, raise_errors=False):
-                if fut.status == "error":  # e.g. KilledWorker after the allowed retries
-                    j = job_of[fut]
-                    row = {**dict(zip(KEY_COLUMNS, j.key, strict=True)),
-                           "status": STATUS_ERROR, "message": f"dask: {fut.exception()}"}
-                record(row)
-        except BaseException:
-            client.cancel(futures)
-            raise
-    finally:
-        if own:
-            client.close()
 
 
 # --------------------------------------------------------------------------- fits
