@@ -122,14 +122,21 @@ def _probe(address: str, timeout: float = CONNECT_TIMEOUT_S) -> None:
 
 @contextlib.contextmanager
 def _quiet_dask_logs():
-    """Hold back Dask's log lines (the lost-connection tracebacks) for the block."""
-    logger = logging.getLogger("distributed")
-    level = logger.level
-    logger.setLevel(logging.CRITICAL + 1)
+    """Hold back Dask's log lines (the lost-connection tracebacks) for the block: every
+    ``distributed`` logger is disabled (Dask's config gives some their own levels, so
+    the parent's level alone does not reach them), then restored."""
+    manager = logging.getLogger().manager
+    names = ["distributed", *(n for n in list(manager.loggerDict)
+                              if n.startswith("distributed."))]
+    loggers = [logging.getLogger(n) for n in names]
+    before = [lg.disabled for lg in loggers]
+    for lg in loggers:
+        lg.disabled = True
     try:
         yield
     finally:
-        logger.setLevel(level)
+        for lg, was in zip(loggers, before, strict=True):
+            lg.disabled = was
 
 
 def _client(scheduler):
