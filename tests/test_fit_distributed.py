@@ -32,11 +32,13 @@ from pathlib import Path
 
 import pytest
 
+import brdfkit
 from brdfkit.fitting.batch import CONNECT_TIMEOUT_S, STATUS_OK, read_checked
 
 distributed = pytest.importorskip("distributed")
 
-SRC = str(Path(__file__).resolve().parents[1] / "src")
+#: The brdfkit under test (the worktree's, or the one PYTHONPATH names) for subprocesses.
+SRC = str(Path(brdfkit.__file__).resolve().parents[1])
 DASK = shutil.which("dask", path=os.path.dirname(sys.executable)) or shutil.which("dask")
 pytestmark = pytest.mark.skipif(DASK is None, reason="the dask command is not installed")
 #: Bounds of the waits (seconds): a process starting (imports of dask and brdfkit on a

@@ -9,22 +9,32 @@ suffix: ``.csv``, ``.parquet``; Parquet needs pyarrow, the ``batch`` extra)
 reader or a crash never sees half a row). Hence:
 
 - **Resume.** Re-running with the same output skips every job whose key is
-  already in the file with status ``ok`` (failed rows are retried and replaced).
+  already in the file with status ``ok`` or ``not-converged`` (failed rows are retried
+  and replaced). Every row read is checked first; an invalid one (cut mid-way, junk) is
+  left out and its job runs again; a file that is not a batch file is refused
+  (:mod:`brdfkit.fitting._batchfile`).
+- **One writer.** A batch holds a lock next to its output; a second batch on the same
+  output is refused in one line naming the other process.
 - **Ctrl-C loses nothing finished.** On an interrupt the pending jobs are
   cancelled and :class:`BatchInterrupted` says how many rows are on disk.
 - **Exactly once.** Rows are keyed (:attr:`Job.key`); a retried job — a Dask
   worker killed mid-task is rescheduled by the scheduler — replaces, never
   duplicates, its row.
+- **Failures are counted**, not raised: :class:`BatchReport` has ``failed`` and the
+  ``failures`` (the command line exits with status 1 and the first reasons).
 
 Where the jobs run
 ------------------
 =================  =========================================================
 ``workers=1``      in this process, one after the other
-``workers=N``      N local processes (``concurrent.futures``, *spawn* start:
-                   Numba's threading layers are not fork-safe)
+``workers=N``      up to N local processes (``concurrent.futures``, *spawn* start:
+                   Numba's threading layers are not fork-safe), at most one per
+                   CPU (:func:`useful_workers`); they die with this process
 ``scheduler=ADDR`` a Dask distributed cluster (``tcp://host:8786``, or a
                    :class:`distributed.Client`/``LocalCluster`` object);
                    ``retries`` re-runs a job whose worker died
+                   (:mod:`brdfkit.fitting._dask`: the address checked, the
+                   scheduler heard within :data:`CONNECT_TIMEOUT_S`)
 =================  =========================================================
 
 A job function takes a :class:`Job` and returns a flat ``dict`` row (str,
@@ -36,7 +46,7 @@ one bad material does not stop a database run.
 Public objects
 --------------
 - :class:`Job`, :func:`run_batch`, :class:`BatchReport`, :class:`BatchInterrupted`,
-  :func:`read_rows`, :func:`write_rows`.
+  :func:`read_rows`, :func:`read_checked`, :func:`write_rows`, :func:`useful_workers`.
 - :func:`fit_row` — the job function of ``brdfkit fit … --out``: one fit, one row.
 - :func:`job_spec` — the :class:`~brdfkit.spec.ModelSpec` of a job's model.
 - :func:`expand_targets` — ``merl:all``, ``rgl:all``, ``nielsen:all`` → material specs.
