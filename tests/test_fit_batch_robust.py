@@ -229,6 +229,21 @@ def test_a_foreign_file_is_refused_in_one_line(tmp_path):
     assert binary.read_bytes() == bytes(range(256)) * 4  # never overwritten
 
 
+def test_parquet_rows_are_checked_too(tmp_path):
+    pytest.importorskip("pyarrow")
+    out = tmp_path / "fits.parquet"
+    rows = _fit_like_rows()
+    rows[1]["status"] = "weird"
+    rows[2]["params"] = '{"rho_d": [0.2'
+    write_rows(out, rows)
+    valid, invalid = read_checked(out)
+    assert [r["target"] for r in valid] == [JOBS[0].target]
+    assert invalid == ["row 2: status 'weird' is none of ok, error, not-converged",
+                       """row 3: params is not JSON ('{"rho_d": [0.2'...)"""]
+    rep = run_batch(JOBS[:3], out=out, run_job=job_fn, notice=lambda line: None)
+    assert (rep.skipped, rep.done) == (1, 2) and not read_checked(out)[1]
+
+
 # --------------------------------------------------------------------------- workers
 def test_workers_are_capped_at_the_cpus(tmp_path):
     """--workers 100: before, one process per job was started (100 on 2 cores for a

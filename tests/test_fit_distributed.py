@@ -69,7 +69,7 @@ def _kill_group(proc: subprocess.Popen) -> None:
 class Cluster:
     """A `dask scheduler` and one `dask worker` (with its nanny), on loopback."""
 
-    def __init__(self, directory: Path):
+    def __init__(self, directory: Path, *, workers: int = 1):
         self.dir = directory
         self.procs: list[subprocess.Popen] = []
         sched_file = directory / "scheduler.json"
@@ -83,10 +83,12 @@ class Cluster:
             return None
 
         self.address = _until("the scheduler's address", address, START_S)
+        self.client = distributed.Client(self.address, set_as_default=False, timeout=20)
+        if not workers:
+            return
         self.worker = self._start("worker", [
             DASK, "worker", self.address, "--nworkers", "1", "--nthreads", "1",
             "--host", "127.0.0.1", "--no-dashboard", "--death-timeout", "60"])
-        self.client = distributed.Client(self.address, set_as_default=False, timeout=20)
         self.client.wait_for_workers(1, timeout=START_S)
 
     def _start(self, name, cmd) -> subprocess.Popen:
@@ -223,6 +225,32 @@ def test_scheduler_going_away_mid_batch(tmp_path):
     assert code == 0, stderr
     assert f"{100 - len(kept)} fitted now, {len(kept)} already there" in stdout
     assert len(_rows(out)) == 100
+
+
+def test_a_scheduler_without_workers_is_said_and_ctrl_c_stops(tmp_path):
+    """The jobs wait for a worker (one may join later), and the user is told so in one
+    line; Ctrl-C (SIGINT to the process group, as a terminal sends it) ends the wait."""
+    c = Cluster(tmp_path, workers=0)
+    out = tmp_path / "fits.csv"
+    try:
+        proc = _cli("fit", "lambert", "--to", MATERIALS[0], "--out", str(out),
+                    "--scheduler", c.address)
+        guard = threading.Timer(START_S, _kill_group, [proc])  # bounds the readline
+        guard.start()
+        try:
+            note = proc.stderr.readline()
+            os.killpg(proc.pid, signal.SIGINT)
+            code, stdout, stderr = _finish(proc, timeout=30)
+        finally:
+            guard.cancel()
+            _kill_group(proc)
+    finally:
+        c.stop()
+    assert note.startswith(f"brdfkit: note: the Dask scheduler {c.address} has no worker yet"), \
+        note
+    assert code == 2 and stderr.strip().splitlines() == [
+        f"brdfkit: error: interrupted: 0 of 1 rows are in {out}; re-run the same command to "
+        "resume"], stderr
 
 
 @contextlib.contextmanager

@@ -271,7 +271,12 @@ def writer_lock(path) -> Iterator[None]:
         return
     lock = lock_path(path)
     while True:
-        fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o666)
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o666)
+        except OSError as exc:
+            raise BrdfkitError(f"--out {os.fspath(path)!r}: cannot create its lock file "
+                               f"{lock!r} ({exc.strerror or exc}); choose a writable "
+                               "directory") from None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:

@@ -99,7 +99,7 @@ def _probe(address: str, timeout: float = CONNECT_TIMEOUT_S) -> None:
         try:
             verdict["info"] = asyncio.run(asyncio.wait_for(_identity(address, timeout),
                                                            timeout))
-        except Exception as exc:  # noqa: BLE001 - any failure is reported as one line below
+        except Exception as exc:  # noqa: BLE001 - carried out of the thread, reported below
             verdict["error"] = exc
 
     thread = threading.Thread(target=run, name="brdfkit-dask-probe", daemon=True)
@@ -160,13 +160,19 @@ def _client(scheduler):
 
 
 def run_dask(todo, *, run_job, scheduler, retries: int, record: Callable[[dict], None],
-             safe: Callable, error_row: Callable[..., dict], where: Callable[[], str]) -> None:
+             safe: Callable, error_row: Callable[..., dict], where: Callable[[], str],
+             say: Callable[[str], None]) -> None:
     """Run *todo* on the cluster, ``record(row)`` as each finishes (module docstring).
-    ``where()`` says how many rows are on disk (for the error when the scheduler goes)."""
+    ``where()`` says how many rows are on disk (for the error when the scheduler goes);
+    ``say(line)`` tells the user what they may not expect (a scheduler without workers)."""
     from distributed import as_completed
 
     client, own = _client(scheduler)
     address = getattr(client.scheduler, "address", None) or str(scheduler)
+    with contextlib.suppress(OSError, TimeoutError):  # a courtesy: the batch runs anyway
+        if todo and not client.scheduler_info().get("workers"):
+            say(f"the Dask scheduler {address} has no worker yet: the jobs wait for one "
+                "('dask worker ADDRESS' starts one; Ctrl-C stops, keeping finished rows)")
     quiet = _quiet_dask_logs() if own else contextlib.nullcontext()
     with quiet:
         try:
@@ -185,7 +191,7 @@ def run_dask(todo, *, run_job, scheduler, retries: int, record: Callable[[dict],
                         row = error_row(job_of[fut], f"dask: {fut.exception()}")
                     record(row)
             except BaseException:
-                with contextlib.suppress(Exception):
+                with contextlib.suppress(OSError, TimeoutError, RuntimeError):
                     client.cancel(futures)
                 raise
             if lost:
@@ -194,5 +200,5 @@ def run_dask(todo, *, run_job, scheduler, retries: int, record: Callable[[dict],
                                    "command to resume")
         finally:
             if own:
-                with contextlib.suppress(Exception):
+                with contextlib.suppress(OSError, TimeoutError, RuntimeError):
                     client.close(timeout=CONNECT_TIMEOUT_S)

@@ -299,7 +299,8 @@ def _run_locked(jobs, path, *, run_job, workers, scheduler, retries, progress, n
             from brdfkit.fitting._dask import run_dask
 
             run_dask(todo, run_job=run_job, scheduler=scheduler, retries=retries,
-                     record=record, safe=_safe, error_row=_error_row, where=where)
+                     record=record, safe=_safe, error_row=_error_row, where=where,
+                     say=lambda line: _say(notice, line))
         elif n_workers == 1:
             for job in todo:
                 record(_safe(run_job, job))
