@@ -43,7 +43,7 @@ DASK = shutil.which("dask", path=os.path.dirname(sys.executable)) or shutil.whic
 pytestmark = pytest.mark.skipif(DASK is None, reason="the dask command is not installed")
 #: Bounds of the waits (seconds): a process starting (imports of dask and brdfkit on a
 #: loaded 2-core machine take a few seconds), a whole command-line batch.
-START_S = 60.0
+START_S = 120.0
 BATCH_S = 240.0
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([SRC, os.environ.get("PYTHONPATH", "")])}
 MATERIALS = ("merl:nickel@abc", "merl:violet-rubber@abc", "merl:gold-paint@abc")
@@ -82,14 +82,20 @@ class Cluster:
                 return json.loads(sched_file.read_text())["address"]
             return None
 
-        self.address = _until("the scheduler's address", address, START_S)
-        self.client = distributed.Client(self.address, set_as_default=False, timeout=20)
-        if not workers:
-            return
-        self.worker = self._start("worker", [
-            DASK, "worker", self.address, "--nworkers", "1", "--nthreads", "1",
-            "--host", "127.0.0.1", "--no-dashboard", "--death-timeout", "60"])
-        self.client.wait_for_workers(1, timeout=START_S)
+        try:
+            self.address = _until("the scheduler's address", address, START_S)
+            self.client = distributed.Client(self.address, set_as_default=False,
+                                             timeout=START_S)
+            if workers:
+                self.worker = self._start("worker", [
+                    DASK, "worker", self.address, "--nworkers", "1", "--nthreads", "1",
+                    "--host", "127.0.0.1", "--no-dashboard", "--death-timeout", "60"])
+                self.client.wait_for_workers(1, timeout=START_S)
+        except BaseException as exc:
+            self.stop()
+            logs = {p.name: p.read_text(errors="replace")[-1500:]
+                    for p in directory.glob("*.log")}
+            raise AssertionError(f"the cluster did not start ({exc!r}); logs: {logs}") from exc
 
     def _start(self, name, cmd) -> subprocess.Popen:
         log = open(self.dir / f"{name}.log", "wb")  # noqa: SIM115 - closed with the process
@@ -106,8 +112,10 @@ class Cluster:
         return None
 
     def stop(self) -> None:
+        client = getattr(self, "client", None)
         with contextlib.suppress(Exception):  # noqa: BLE001 - teardown of a possibly dead cluster
-            self.client.close(timeout=5)
+            if client is not None:
+                client.close(timeout=5)
         for proc in reversed(self.procs):
             _kill_group(proc)
 

@@ -85,8 +85,11 @@ def check_address(address) -> str:
 
 async def _identity(address: str, timeout: float) -> dict:
     from distributed.core import rpc
+    from distributed.security import Security
 
-    async with rpc(address, timeout=timeout) as scheduler:
+    # the TLS settings a Client would take from Dask's configuration
+    args = Security().get_connection_args("client")
+    async with rpc(address, timeout=timeout, connection_args=args) as scheduler:
         return await scheduler.identity()
 
 
