@@ -44,6 +44,9 @@ pytestmark = pytest.mark.skipif(DASK is None, reason="the dask command is not in
 #: Bounds of the waits (seconds): a process starting (imports of dask and brdfkit on a
 #: loaded 2-core machine take a few seconds), a whole command-line batch.
 START_S = 120.0
+#: Where the scheduler's and worker's HTTP servers listen: Dask starts one (health,
+#: metrics) even with --no-dashboard, on 0.0.0.0:8787 unless told otherwise.
+LOOPBACK_ANY_PORT = "127.0.0.1:0"
 BATCH_S = 240.0
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([SRC, os.environ.get("PYTHONPATH", "")])}
 MATERIALS = ("merl:nickel@abc", "merl:violet-rubber@abc", "merl:gold-paint@abc")
@@ -75,7 +78,7 @@ class Cluster:
         sched_file = directory / "scheduler.json"
         self.scheduler = self._start("scheduler", [
             DASK, "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-            "--scheduler-file", str(sched_file)])
+            "--dashboard-address", LOOPBACK_ANY_PORT, "--scheduler-file", str(sched_file)])
 
         def address():
             with contextlib.suppress(OSError, ValueError):
@@ -89,7 +92,8 @@ class Cluster:
             if workers:
                 self.worker = self._start("worker", [
                     DASK, "worker", self.address, "--nworkers", "1", "--nthreads", "1",
-                    "--host", "127.0.0.1", "--no-dashboard", "--death-timeout", "60"])
+                    "--host", "127.0.0.1", "--no-dashboard", "--dashboard-address",
+                    LOOPBACK_ANY_PORT, "--death-timeout", "60"])
                 self.client.wait_for_workers(1, timeout=START_S)
         except BaseException as exc:
             self.stop()
@@ -113,11 +117,13 @@ class Cluster:
 
     def stop(self) -> None:
         client = getattr(self, "client", None)
-        with contextlib.suppress(Exception):  # noqa: BLE001 - teardown of a possibly dead cluster
-            if client is not None:
-                client.close(timeout=5)
-        for proc in reversed(self.procs):
-            _kill_group(proc)
+        try:
+            with contextlib.suppress(Exception):  # noqa: BLE001 - a possibly dead cluster
+                if client is not None:
+                    client.close(timeout=5)
+        finally:  # the processes go whatever the client did (a CancelledError escapes above)
+            for proc in reversed(self.procs):
+                _kill_group(proc)
 
 
 @pytest.fixture(scope="module")
