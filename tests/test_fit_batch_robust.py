@@ -209,6 +209,27 @@ def test_invalid_rows_are_dropped_even_when_nothing_is_left_to_run(tmp_path):
     assert out.read_text(encoding="utf-8") == text
 
 
+def test_a_byte_order_mark_is_no_foreign_file(tmp_path):
+    """A spreadsheet saving the CSV as 'UTF-8 with BOM' puts U+FEFF before the header."""
+    out = tmp_path / "fits.csv"
+    text = _written(out, _fit_like_rows())
+    out.write_bytes(b"\xef\xbb\xbf" + text.encode("utf-8"))
+    rep = run_batch(JOBS[:3], out=out, run_job=job_fn)
+    assert (rep.skipped, rep.done, rep.invalid) == (3, 0, [])
+
+
+def weird_status(job):
+    return {"status": "fine, thanks"}
+
+
+def test_a_row_with_a_status_of_its_own_is_an_error_row(tmp_path):
+    """Written as it was, it would be an invalid row on every resume."""
+    out = tmp_path / "fits.csv"
+    rep = run_batch(JOBS[:1], out=out, run_job=weird_status)
+    assert rep.failed == 1 and "returned status 'fine, thanks'" in rep.failures[0]
+    assert read_checked(out)[0][0]["status"] == STATUS_ERROR
+
+
 def test_a_foreign_file_is_refused_in_one_line(tmp_path):
     """Before: UnicodeDecodeError (a traceback) for a binary or Parquet file named .csv."""
     binary = tmp_path / "binary.csv"

@@ -117,7 +117,7 @@ def _read_csv(p: str) -> tuple[list[dict], list[tuple[int, str]]]:
     if data.startswith(_PARQUET_MAGIC):
         raise _foreign(p, "it is a Parquet file; name it .parquet")
     try:
-        text = data.decode("utf-8")
+        text = data.decode("utf-8-sig")  # a byte-order mark (a spreadsheet's save) is skipped
     except UnicodeDecodeError as exc:
         raise _foreign(p, f"not UTF-8 text: byte 0x{data[exc.start]:02x} at offset "
                           f"{exc.start}") from None

@@ -74,6 +74,7 @@ from brdfkit.fitting._batchfile import (
     STATUS_ERROR,
     STATUS_NOT_CONVERGED,
     STATUS_OK,
+    STATUSES,
     SUFFIXES,
     describe_invalid,
     is_parquet,
@@ -146,6 +147,9 @@ def _safe(run_job: Callable[[Job], dict], job: Job) -> dict:
     try:
         row = dict(run_job(job))
         row.setdefault("status", STATUS_OK)
+        if row["status"] not in STATUSES:  # it would be an invalid row on resume
+            raise BrdfkitError(f"the job function returned status {row['status']!r}; "
+                               f"expected one of {', '.join(STATUSES)}")
     except Exception as exc:  # noqa: BLE001 - any failure of one job is recorded, not raised
         last = traceback.extract_tb(exc.__traceback__)[-1:]
         where = f" ({last[0].filename.rsplit(os.sep, 1)[-1]}:{last[0].lineno})" if last else ""
