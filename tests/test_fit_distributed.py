@@ -267,6 +267,17 @@ def test_a_scheduler_without_workers_is_said_and_ctrl_c_stops(tmp_path):
         "resume"], stderr
 
 
+def test_a_worker_address_is_not_a_scheduler(cluster, tmp_path):
+    """Given the worker's address by mistake (it speaks Dask, but is no scheduler)."""
+    worker = next(iter(cluster.client.scheduler_info()["workers"]))
+    code, stdout, stderr = _finish(_cli("fit", "lambert", "--to", MATERIALS[0], "--out",
+                                        str(tmp_path / "fits.csv"), "--scheduler", worker),
+                                   timeout=60)
+    assert code == 2 and stderr.strip().splitlines() == [
+        f"brdfkit: error: --scheduler {worker}: answers as a Dask Worker, not a scheduler; "
+        "give the scheduler's address"], stderr
+
+
 @contextlib.contextmanager
 def _http_server():
     """A real HTTP server on a free loopback port: it accepts a TCP connection and
