@@ -72,11 +72,11 @@ def _kill_group(proc: subprocess.Popen) -> None:
 class Cluster:
     """A `dask scheduler` and one `dask worker` (with its nanny), on loopback."""
 
-    def __init__(self, directory: Path, *, workers: int = 1):
+    def __init__(self, directory: Path, *, workers: int = 1, scheduler_env=None):
         self.dir = directory
         self.procs: list[subprocess.Popen] = []
         sched_file = directory / "scheduler.json"
-        self.scheduler = self._start("scheduler", [
+        self.scheduler = self._start("scheduler", env={**ENV, **(scheduler_env or {})}, cmd=[
             DASK, "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
             "--dashboard-address", LOOPBACK_ANY_PORT, "--scheduler-file", str(sched_file)])
 
@@ -90,7 +90,7 @@ class Cluster:
             self.client = distributed.Client(self.address, set_as_default=False,
                                              timeout=START_S)
             if workers:
-                self.worker = self._start("worker", [
+                self.worker = self._start("worker", cmd=[
                     DASK, "worker", self.address, "--nworkers", "1", "--nthreads", "1",
                     "--host", "127.0.0.1", "--no-dashboard", "--dashboard-address",
                     LOOPBACK_ANY_PORT, "--death-timeout", "60"])
@@ -101,9 +101,9 @@ class Cluster:
                     for p in directory.glob("*.log")}
             raise AssertionError(f"the cluster did not start ({exc!r}); logs: {logs}") from exc
 
-    def _start(self, name, cmd) -> subprocess.Popen:
+    def _start(self, name, cmd, env=ENV) -> subprocess.Popen:
         log = open(self.dir / f"{name}.log", "wb")  # noqa: SIM115 - closed with the process
-        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=ENV,
+        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=env,
                                 start_new_session=True)
         log.close()
         self.procs.append(proc)
@@ -206,6 +206,36 @@ def test_worker_killed_mid_task(cluster, tmp_path):
     rows = _rows(out)
     assert set(rows) == {("ward", m) for m in MATERIALS}
     assert all(r["status"] == STATUS_OK for r in rows.values()), rows
+
+
+def test_a_task_whose_worker_always_dies_is_an_error_row_and_exit_1(tmp_path):
+    """With Dask's allowed-failures at 0, the first worker death while a task runs makes
+    it a KilledWorker: its row says so (status error), the batch exits 1 naming it, and
+    a re-run retries it."""
+    out = tmp_path / "fits.csv"
+    c = Cluster(tmp_path, scheduler_env={"DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "0"})
+    try:
+        old = _until("the worker's pid", c.worker_pid, START_S)
+        proc = _cli("fit", "ward", "--to", MATERIALS[0], "--out", str(out), "--scheduler",
+                    c.address)
+        try:
+            _until("the task on the worker",
+                   lambda: [k for ks in c.client.processing().values() for k in ks], START_S)
+            time.sleep(0.5)  # inside the task: a fresh worker's first fit takes seconds
+            assert not out.exists(), "the fit finished before the kill"
+            os.kill(old, signal.SIGKILL)
+            code, stdout, stderr = _finish(proc, timeout=START_S)
+        finally:
+            _kill_group(proc)
+    finally:
+        c.stop()
+    assert code == 1, (stdout, stderr)
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        f"brdfkit: error: 1 of 1 fits failed ({MATERIALS[0]} (ward): dask: "), stderr
+    assert "died" in lines[0]  # Dask's KilledWorker: "... workers died while running it"
+    [row] = _rows(out).values()
+    assert row["status"] == "error" and row["message"].startswith("dask: ")
 
 
 def test_scheduler_going_away_mid_batch(tmp_path):
