@@ -173,8 +173,10 @@ def _reciprocity(model) -> tuple[float, int, int]:
     """(asymmetry over the pairs where both values exist, pairs without both, all pairs).
     A plain callable claims nothing: it gets the anisotropic pair set."""
     if isinstance(model, BRDF) and model.isotropic:
-        ti, to, dp = np.meshgrid(_PAIR_THETA_DEG, _PAIR_THETA_DEG, _PAIR_DPHI_DEG,
-                                 indexing="ij")
+        # rotation invariant: L at azimuth 0 stands for every azimuth; one side of the plane
+        # of incidence stands for both only for a mirror-symmetric model
+        dphi = _PAIR_DPHI_DEG if model.mirror_symmetric else _ANISO_DPHI_DEG
+        ti, to, dp = np.meshgrid(_PAIR_THETA_DEG, _PAIR_THETA_DEG, dphi, indexing="ij")
         pl = np.zeros(ti.size)
     else:
         ti, to, p0, dp = np.meshgrid(_PAIR_THETA_DEG, _PAIR_THETA_DEG, _ANISO_PHI_DEG,
