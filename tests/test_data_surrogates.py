@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import brdfkit
 import brdfkit.data as bd
 from brdfkit.analysis.albedo_engine import albedo
 from brdfkit.data import catalog
@@ -423,3 +424,19 @@ def test_shipped_files_are_byte_copies_of_the_reference():
         if p.name != "README.md":
             assert (hashlib.sha256(p.read_bytes()).hexdigest()
                     == hashlib.sha256((SHARED / p.name).read_bytes()).hexdigest()), p.name
+
+
+def test_a_verdict_on_a_surrogate_says_it_is_the_surrogates():
+    """merl:nickel's NBRDF is not reciprocal where its ABC fit is (by form): check says that
+    the verdict is on the representation (issue 20), for every material, never for a
+    formula (reference: the declarations — NBRDF's ``reciprocal`` False, ABC's True)."""
+    from brdfkit.analysis import check
+
+    for spec, fit_word in (("merl:nickel", "the net enforces neither"),
+                           ("merl:nickel@abc", "reciprocal by its form")):
+        v = check(bd.material(spec), tol=1e-5)
+        note = next((n for n in v.notes if n.startswith("these verdicts are on the ")), None)
+        assert note is not None and fit_word in note and "nickel" in note, v.notes
+    assert check(bd.material("merl:nickel"), tol=1e-5).reciprocity == "not reciprocal"
+    assert not any("these verdicts are on" in n
+                   for n in check(brdfkit.model("lambert"), tol=1e-5).notes)

@@ -283,6 +283,9 @@ def check(model, *, tol: float = 1e-7, phi: float = 0.0) -> Verdict:
     a = np.asarray(r.albedo).reshape(grid.size, -1)
     err = float(np.max(np.asarray(r.error)))
     notes: list[str] = []
+    prov = model.provenance()
+    if prov:  # a verdict on a representation of data (a surrogate, a table) says so
+        notes.append(f"these verdicts are on {prov}")
     if n_missing:
         notes.append(f"reciprocity {'undetermined' if recip == 'undetermined' else 'judged'}"
                      f": {n_missing} of {n_pairs} pairs have no value (NaN) in one order and "

@@ -204,6 +204,12 @@ class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
     def lobes(self):
         return [Lobe("diffuse", 0.5 * math.pi), Lobe("half", self._width)]
 
+    def provenance(self) -> str:
+        """Verdicts on this model are verdicts on the table and its lookup (docstring)."""
+        return (f"the tabulated values of {self.table.source} ({self.values['lookup']} "
+                "lookup on the MERL grid): reciprocal by the grid's fold, whatever was "
+                "measured; its albedo is the table's")
+
     def with_params(self, **changes) -> MeasuredBRDF:
         unknown = set(changes) - {"lookup"}
         if unknown:

@@ -187,6 +187,17 @@ class SurrogateBRDF(TabulatedSampler, DerivedBRDF):
             return [Lobe("diffuse", HALF_PI)]
         return [Lobe("diffuse", HALF_PI), Lobe("half", self._width)]
 
+    def provenance(self) -> str:
+        """Verdicts on this model are verdicts on the surrogate (class docstring)."""
+        what = (f"the {self.representation.upper()} surrogate of {self.material} "
+                f"({self.source.upper()}), a fit of the measurement, not the measurement")
+        if self.representation == "nbrdf":
+            others = (f" (merl:{self.material}@npf, @abc and @sgd are reciprocal by their "
+                      "form)" if self.source == "merl" else "")
+            return (f"{what}: the net enforces neither reciprocity nor mirror symmetry, so "
+                    f"an asymmetry it shows is the fit's, not the material's{others}")
+        return f"{what}: reciprocal by its form; its albedo is the fit's"
+
     def albedo_kinks_nv(self, theta) -> np.ndarray | None:
         """SGD: G₁(θ_o) has a kink at θ_o = θ₀ per channel (the max(0, θ − θ₀)): levels
         N·V = cos θ₀ for θ₀ ∈ (0, π/2), the same for every θ_i."""

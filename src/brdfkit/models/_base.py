@@ -140,6 +140,8 @@ class BRDF:
       (:class:`brdfkit._dual.Formulas`), or None (the default).
     - :meth:`fresnel_split` — the white (F = 1) form and F₀, F_avg of a model with a
       Fresnel factor, or None (the default: the model is its own white form).
+    - :meth:`provenance` — what a verdict on the model is a verdict on, when that is a
+      representation of data (a surrogate, a table), or None (the default: a formula).
 
     Models built from other models (pumped, measured, fitted, wrapped) derive
     from :class:`DerivedBRDF`, which passes through the same set-up.
@@ -483,6 +485,14 @@ class BRDF:
         ``white`` and weight the restored energy with F₀ (Turquin) or F_avg (Kulla–Conty).
         Default: None — the model is its own white form, F₀ = F_avg = 1.
         """
+        return None
+
+    def provenance(self) -> str | None:
+        """Where the model's values come from when a verdict on it is a verdict on that
+        representation rather than on a formula: a measured material's surrogate (a fitted
+        net need not be reciprocal though the material is), a tabulated file. The
+        plausibility check adds it to its notes. Default: None (a formula: its verdicts
+        are the formula's)."""
         return None
 
     def formulas(self) -> Formulas | None:
