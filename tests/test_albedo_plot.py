@@ -52,3 +52,30 @@ def test_the_cli_plot_is_written(tmp_path):
                                   "0,60,85", "--plot", str(out)])
     assert r.exit_code == 0, r.output
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_fit_figure_draws_f_r_and_keeps_slice_colours_apart_from_channels():
+    # `fit --plot` drew f_r·cos θ_i beside `figure slices`' f_r, and θ_i = 60° in the red of
+    # the R channel (issue 20). Reference: the target's own f_r at θ_i = 0, θ_o = 0 (normal
+    # incidence and view: the first slice's value at its middle).
+    from brdfkit.figures.fitting import SLICE_THETA_DEG, fit_figure
+    from brdfkit.fitting import fit
+
+    target = brdfkit.model("modified-phong", rho_d=[0.3, 0.2, 0.1], rho_s=0.5, n=30)
+    r = fit(brdfkit.model("modified-phong"), target, strides=(15, 45))
+    fig = fit_figure(r, target)
+    try:
+        ax, bx = fig.axes[:2]
+        assert "cos" not in ax.get_ylabel() and "f_r" in ax.get_ylabel()
+        first = ax.lines[0]
+        x, y = np.asarray(first.get_xdata()), np.asarray(first.get_ydata())
+        n = np.array([0.0, 0.0, 1.0])
+        want = float(np.mean(target.eval(n, n)))
+        np.testing.assert_allclose(np.interp(0.0, x, y), want, rtol=1e-3)
+        slice_colours = [ln.get_color() for ln in ax.lines][:2 * len(SLICE_THETA_DEG)]
+        for c in ("tab:red", "tab:green", "tab:blue"):
+            assert not any(mcolors.same_color(s, c) for s in slice_colours)
+        assert [ln.get_label() for ln in bx.lines][::2] == ["R measured", "G measured",
+                                                            "B measured"]
+    finally:
+        plt.close(fig)
