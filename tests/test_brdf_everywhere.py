@@ -237,7 +237,7 @@ def test_export_of_a_colour_file(tmp_path):
 def test_render_sphere_exact_lambert_closed_form(tmp_path):
     out = tmp_path / "l.npy"
     r = run("render", "sphere", LAMBERT, "-p", "rho=0.6", "--phi-l", "0", "--size", "16",
-            "--out", out)
+            "--antialias", "1", "--out", out)
     assert r.exit_code == 0, r.output
     img = np.load(out)[..., 0]
     c = (np.arange(16) + 0.5) / 16 * 2.0 - 1.0
@@ -341,7 +341,7 @@ def test_api_fit_stays_within_the_files_ranges(phong):
     assert wide.params["n"] > 10.0  # nickel wants a sharper lobe than the narrow file allows
     r = fit(brdfkit.model(str(phong / "narrow.brdf")), target)
     assert 1.0 <= r.params["n"] <= 10.0 and r.params["n"] == pytest.approx(10.0, rel=1e-6)
-    assert "n at its upper bound 10" in r.message
+    assert "n = 10, at its upper bound 10" in r.message
     for name in ("rho_d", "rho_s"):  # a color's components: [0, 1]
         assert all(0.0 <= v <= 1.0 for v in r.params[name])
     assert r.value > wide.value  # the bound costs

@@ -132,3 +132,20 @@ def test_the_ngan_projection_is_exact():
         best += float(np.sum((A @ sol.x - prob.y[k, c] * np.sqrt(w)) ** 2))
     reference = float(np.sqrt(best / (np.sum(w) * 3)))
     assert r.value == pytest.approx(reference, rel=1e-6)
+
+
+def test_a_parameter_the_data_do_not_determine_is_called_inert_not_at_a_bound():
+    # Regression (issue 20): a diffuse target fitted by Nielsen's model ends with k_s = 0,
+    # and then s and alpha change nothing (identity of eq. (3): the lobe's weight is k_s),
+    # which was reported "s = 27.39, indistinguishable from its lower bound 0" and
+    # "alpha = 0.9999, indistinguishable from its lower bound 0" (α sat at its *upper* one).
+    target = brdfkit.model("nielsen", rho_d=0.3, k_s=0.0)  # Lambertian: f = 0.3/π
+    r = fit(brdfkit.model("nielsen"), target, strides=(15, 45))
+    assert r.params["k_s"] == pytest.approx(0.0, abs=1e-9)
+    assert r.params["rho_d"] == pytest.approx(0.3, rel=1e-6)
+    assert {"s", "alpha"} <= set(r.convergence["inert"]), r.message
+    bounded = {b["parameter"] for b in r.convergence["at_bounds"]}
+    assert not bounded & {"s", "alpha"}, r.message
+    assert "inert" in r.message and "indistinguishable" not in r.message, r.message
+    # an at-bound coordinate is named with its value and which bound
+    assert "k_s = 0, at its lower bound 0" in r.message, r.message

@@ -21,7 +21,7 @@ from click.testing import CliRunner
 import brdfkit
 from brdfkit.analysis import albedo
 from brdfkit.cli import main
-from brdfkit.errors import BrdfkitError
+from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models import DerivedBRDF
 from brdfkit.render import (
     exposure_phi0,
@@ -59,7 +59,7 @@ def test_lambert_sphere_closed_form():
     # E·ρ/π·max(N·L, 0) + L_a·ρ (the albedo of Lambert is ρ at every angle)
     S, phi, E, L_a, rho = 17, math.radians(40.0), 2.0, 0.3, 0.6
     r = render_sphere(brdfkit.model("lambert", rho_d=rho), phi_l=phi, ambient=L_a,
-                      irradiance=E, size=S)
+                      irradiance=E, size=S, antialias=1)
     N, inside = _normals(S)
     L = np.array([math.sin(phi), 0.0, math.cos(phi)])
     expect = np.where(inside, E * rho / math.pi * np.maximum(N @ L, 0.0) + L_a * rho, 0.0)
@@ -82,7 +82,7 @@ class _NumpyLambert(DerivedBRDF):
 
 def test_model_without_kernel_closed_form():
     S, phi = 9, math.radians(100.0)
-    r = render_sphere(_NumpyLambert(0.5), phi_l=phi, size=S)
+    r = render_sphere(_NumpyLambert(0.5), phi_l=phi, size=S, antialias=1)
     N, inside = _normals(S)
     L = np.array([math.sin(phi), 0.0, math.cos(phi)])
     assert np.allclose(r.radiance[..., 0], np.where(inside, 0.5 / math.pi
@@ -95,7 +95,7 @@ def test_phong_pixels_by_hand_in_the_world_frame():
     S, phi, E = 12, math.radians(50.0), 1.5
     k_d, k_s, n = np.array([0.1, 0.2, 0.3]), 0.8, 7.0
     m = brdfkit.model("phong", k_d=k_d.tolist(), k_s=k_s, n=n)
-    r = render_sphere(m, phi_l=phi, irradiance=E, size=S)
+    r = render_sphere(m, phi_l=phi, irradiance=E, size=S, antialias=1)
     N, inside = _normals(S)
     L = np.array([math.sin(phi), 0.0, math.cos(phi)])
     V = np.array([0.0, 0.0, 1.0])
@@ -116,7 +116,7 @@ def test_transposed_model_pixels_by_hand():
     m = transposed(brdfkit.model("phong", k_d=k_d, k_s=k_s, n=n))
     assert m.name == "phong^T" and not m.reciprocal
     S, phi = 10, math.radians(70.0)
-    r = render_sphere(m, phi_l=phi, size=S)
+    r = render_sphere(m, phi_l=phi, size=S, antialias=1)
     N, _ = _normals(S)
     L = np.array([math.sin(phi), 0.0, math.cos(phi)])
     V = np.array([0.0, 0.0, 1.0])
@@ -135,7 +135,7 @@ def test_ambient_of_a_non_reciprocal_model_integrates_over_the_light():
 
     k_s, n, L_a, S = 1.0, 2.0, 1.0, 15
     m = brdfkit.model("phong", k_d=0.0, k_s=k_s, n=n)
-    r = render_sphere(m, phi_l=0.0, ambient=L_a, irradiance=0.0, size=S)
+    r = render_sphere(m, phi_l=0.0, ambient=L_a, irradiance=0.0, size=S, antialias=1)
     c = S // 2
     assert r.radiance[c, c, 0] == pytest.approx(2 * math.pi / (n + 1), abs=1e-6)
     # a pixel at θ_V ≈ 60° against SciPy's dblquad over the light hemisphere
@@ -157,7 +157,7 @@ def test_ambient_matches_the_albedo_engine_at_the_pixel_angles():
     # reciprocal model: L_a·a(θ_V), a computed by the engine directly at each pixel's angle
     m = brdfkit.model("modified-phong", rho_d=0.2, rho_s=0.6, n=200)
     S, L_a = 24, 0.7
-    r = render_sphere(m, phi_l=0.3, ambient=L_a, irradiance=0.0, size=S)
+    r = render_sphere(m, phi_l=0.3, ambient=L_a, irradiance=0.0, size=S, antialias=1)
     N, inside = _normals(S)
     theta = np.arccos(N[inside][:, 2])
     pick = np.argsort(theta)[:: max(1, theta.size // 25)]  # ~25 angles incl. near grazing
@@ -308,3 +308,43 @@ def test_light_azimuth_rotates_the_image():
     np.testing.assert_allclose(b, np.rot90(a), atol=1e-12 * a.max())
     with pytest.raises(brdfkit.ParameterError, match="light_azimuth"):
         render_sphere(m, phi_l=0.6, light_azimuth=float("nan"), size=4)
+
+
+def test_antialiased_rim_area_is_the_discs_and_centres_are_unchanged():
+    # Ambient light only on a Lambertian sphere: the radiance is L_a·ρ wherever the sphere
+    # is (its albedo, a closed form), so Σ pixels × pixel area = L_a·ρ × the disc's area
+    # π (the image spans [−1, 1]²). The centre-only image gets the area wrong by its
+    # staircase; the anti-aliased one within the midpoint rule's coverage error.
+    S, L_a, rho = 48, 1.0, 0.5
+    m = brdfkit.model("lambert", rho_d=rho)
+    pix = (2.0 / S) ** 2
+    aa = render_sphere(m, phi_l=0.0, ambient=L_a, irradiance=0.0, size=S, antialias=8)
+    flat = render_sphere(m, phi_l=0.0, ambient=L_a, irradiance=0.0, size=S, antialias=1)
+    area = math.pi * L_a * rho
+    err_aa = abs(aa.radiance.sum() * pix - area) / area
+    err_flat = abs(flat.radiance.sum() * pix - area) / area
+    assert err_aa < 2e-3 and err_aa < err_flat / 3, (err_aa, err_flat)
+    # every rim pixel holds a share of L_a·ρ in [0, L_a·ρ]; pixels away from the rim are
+    # the exact centre values of the flat render
+    r = aa.radiance[..., 0]
+    assert np.all(r >= 0.0) and np.all(r <= L_a * rho * (1 + 1e-12))
+    c = (np.arange(S) + 0.5) / S * 2 - 1
+    rad = np.hypot(c[None, :], c[:, None])
+    away = np.abs(rad - 1.0) > math.sqrt(2.0) / S
+    np.testing.assert_array_equal(r[away], flat.radiance[..., 0][away])
+    assert 0 < np.count_nonzero((r > 0) & (r < L_a * rho * (1 - 1e-9)))  # partial pixels
+    with pytest.raises(ParameterError, match="antialias must be an integer from 1 to 16"):
+        render_sphere(m, phi_l=0.0, size=8, antialias=0)
+
+
+def test_terminator_pixels_are_those_the_line_n_dot_l_0_crosses():
+    # L = +x: the terminator is the line x = 0 (N·L = N_x); for S = 8 it is the edge
+    # between columns 3 and 4, so N·L > 0 holds at some corners of the column-4 pixels
+    # and not at those on x = 0: exactly column 4 (8 rows) is crossed (by construction).
+    from brdfkit.render.silhouette import terminator_pixels
+
+    idx = terminator_pixels(8, (1.0, 0.0, 0.0))
+    rows, cols = np.divmod(idx, 8)
+    assert set(cols.tolist()) == {4} and sorted(rows.tolist()) == list(range(8))
+    # L = +z (behind the viewer): N·L = N_z > 0 on the whole disc, no terminator
+    assert terminator_pixels(8, (0.0, 0.0, 1.0)).size == 0

@@ -32,9 +32,10 @@ variable (which removes √-type endpoint singularities such as Ward's
 estimate exceeds the tolerance every panel is halved in both directions and
 the angle recomputed (up to 5 times).
 
-Isotropic models are integrated over φ ∈ [0, φ_max] and doubled (mirror
-symmetry about the plane of incidence); anisotropic models (``isotropic`` False) and
-plain callables over both halves.
+Models that declare both ``isotropic`` and ``mirror_symmetric`` are integrated over
+φ ∈ [0, φ_max] and doubled (mirror symmetry about the plane of incidence); anisotropic
+models, isotropic ones that are not even in φ_i − φ_o (an NBRDF net, a noisy measured
+table) and plain callables over both halves.
 
 Incidence azimuth. ω_i = (sin θ_i cos φ_i, sin θ_i sin φ_i, cos θ_i): the nodes are
 generated for ω_i at azimuth 0 and rotated about the normal by φ_i, with ω_i, where f is
@@ -475,7 +476,8 @@ def albedo(model, theta_i, *, phi=0.0, tol: float = 1e-7, mode: str | None = Non
     Notes
     -----
     The model protocol (:class:`~brdfkit.models.BRDF`) is all the engine reads:
-    ``isotropic`` (integrate half the azimuths and double; φ_i not applied), ``albedo_kinks``
+    ``isotropic`` (φ_i not applied) and ``mirror_symmetric`` (with it: integrate half the
+    azimuths and double), ``albedo_kinks``
     (``"nv=nl"``, ``"vgroove"``: closed-form curves made panel edges),
     ``albedo_kinks_nv(theta)`` (up to 12 levels k of circles N·V = k per angle,
     e.g. where a pumped model's g switches branch; edges in every frame, closed
@@ -525,8 +527,11 @@ def albedo(model, theta_i, *, phi=0.0, tol: float = 1e-7, mode: str | None = Non
             n_channels = P.shape[0]
         else:
             evaluate, n_channels = _callable_evaluator(model.eval, "albedo: model.eval")
-        # the mirror-symmetric half-azimuth shortcut only for an isotropic model
-        a, e, status = _integrate(evaluate, flat, phis, m_mode, m_width, model.isotropic, tol,
+        # the half-azimuth shortcut (integrate φ_o on one side of the plane of incidence and
+        # double) only for a model that declares both symmetries it rests on: rotation
+        # invariance (φ_i = 0 stands for every φ_i) and evenness in φ_i − φ_o
+        sym = bool(model.isotropic and model.mirror_symmetric)
+        a, e, status = _integrate(evaluate, flat, phis, m_mode, m_width, sym, tol,
                                   n_channels, _kink_flags(model), _declared_levels(model, flat))
         coloured = model.n_channels is not None
         extra = model.specular_albedo(flat)

@@ -173,8 +173,10 @@ def _reciprocity(model) -> tuple[float, int, int]:
     """(asymmetry over the pairs where both values exist, pairs without both, all pairs).
     A plain callable claims nothing: it gets the anisotropic pair set."""
     if isinstance(model, BRDF) and model.isotropic:
-        ti, to, dp = np.meshgrid(_PAIR_THETA_DEG, _PAIR_THETA_DEG, _PAIR_DPHI_DEG,
-                                 indexing="ij")
+        # rotation invariant: L at azimuth 0 stands for every azimuth; one side of the plane
+        # of incidence stands for both only for a mirror-symmetric model
+        dphi = _PAIR_DPHI_DEG if model.mirror_symmetric else _ANISO_DPHI_DEG
+        ti, to, dp = np.meshgrid(_PAIR_THETA_DEG, _PAIR_THETA_DEG, dphi, indexing="ij")
         pl = np.zeros(ti.size)
     else:
         ti, to, p0, dp = np.meshgrid(_PAIR_THETA_DEG, _PAIR_THETA_DEG, _ANISO_PHI_DEG,
@@ -281,6 +283,9 @@ def check(model, *, tol: float = 1e-7, phi: float = 0.0) -> Verdict:
     a = np.asarray(r.albedo).reshape(grid.size, -1)
     err = float(np.max(np.asarray(r.error)))
     notes: list[str] = []
+    prov = model.provenance()
+    if prov:  # a verdict on a representation of data (a surrogate, a table) says so
+        notes.append(f"these verdicts are on {prov}")
     if n_missing:
         notes.append(f"reciprocity {'undetermined' if recip == 'undetermined' else 'judged'}"
                      f": {n_missing} of {n_pairs} pairs have no value (NaN) in one order and "

@@ -130,11 +130,13 @@ def _phi_note(m, phi_deg: float) -> str | None:
                    "theta_deg for an anisotropic model or a --phi other than 0).")
 @click.option("--plot", "plot", default=None, metavar="FILE",
               help="Also write a plot of a(theta_i) to FILE (.png or .svg; the directory "
-                   "must exist).")
+                   "must exist): a dense curve (every degree, to 1e-5) with the --theta "
+                   "angles marked, R/G/B in red/green/blue, the line a = 1.")
 def albedo_cmd(model, param, compensate, pump, times, theta, phi, tol, as_json, as_csv, plot):
     """Directional albedo a(theta_i) = int f_r cos(theta_o) dw_o of MODEL, with error estimates.
 
-    Deterministic lobe-aware quadrature (accurate to ~1e-7). Example:
+    Deterministic lobe-aware quadrature to the --tol goal (1e-7 absolute by default); each
+    angle's error estimate is printed beside it. Example:
     brdfkit albedo modified-phong -p n=5000 --theta 0:89:90 --json
     """
     from brdfkit.analysis import albedo
@@ -155,7 +157,7 @@ def albedo_cmd(model, param, compensate, pump, times, theta, phi, tol, as_json, 
     # it always was)
     with_phi = not m.isotropic or phi_deg != 0.0
     if plot:
-        _plot_albedo(th, a, m.name, plot, phi_deg if with_phi else None)
+        _plot_albedo(m, th, a, plot, phi_deg if with_phi else None)
     # an angle that did not converge (e.g. NaN in the integrand) says so: the result's
     # status and message, present only then (the output of converged runs is unchanged)
     unconverged = {k: v for k, v in r.to_dict().items() if k in ("status", "message")}
@@ -194,27 +196,16 @@ def albedo_cmd(model, param, compensate, pump, times, theta, phi, tol, as_json, 
             click.echo(f"{th[k]:10.4f}  {a[k]:.9f}  ({e[k]:.1e})")
 
 
-def _plot_albedo(th, a, name, path, phi_deg=None):
+def _plot_albedo(m, th, a, path, phi_deg=None):
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     from brdfkit.figures import save_atomic
+    from brdfkit.figures.albedo import albedo_figure
 
-    fig, ax = plt.subplots(figsize=(5.2, 4.0))
-    if a.ndim == 2:
-        for c in range(a.shape[1]):
-            ax.plot(th, a[:, c], label=f"channel {c}")
-        ax.legend(fontsize=8)
-    else:
-        ax.plot(th, a, label=name)
-        ax.legend(fontsize=8)
-    ax.set_xlabel(r"incidence angle $\theta_i$ (degrees)")
-    ax.set_ylabel(r"albedo $a(\theta_i)$")
-    ax.set_title(f"directional albedo of {name}"
-                 + ("" if phi_deg is None else f" at $\\phi_i$ = {phi_deg:g}°"), fontsize=10)
-    ax.grid(alpha=0.3)
+    fig = albedo_figure(m, th, a, phi_deg=phi_deg)
     try:
         save_atomic(fig, path, option="--plot")
     finally:

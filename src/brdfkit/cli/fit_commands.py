@@ -16,6 +16,7 @@ import json
 import math
 
 import click
+import numpy as np
 
 import brdfkit.cli._progress as _progress
 from brdfkit.cli._common import COMPENSATE_HELP, PARAM_HELP, emit_json
@@ -132,13 +133,31 @@ def fit_cmd(models, param, start, compensate, pump, times, to, loss, procedure, 
                f"{r.message}")
     for k, v in d["params"].items():
         click.echo(f"{k:>10s} = {v}")
+    off = [p for p in m.params if p.default is None and d["params"].get(p.name) is None]
+    for p in off:  # an optional factor left out is said, with how to fit it
+        click.echo(f"# {p.name} unset, so not fitted ({p.doc}); --start {p.name}=VALUE fits it")
     click.echo("# metrics: " + ", ".join(f"{k}={v:.6g}" for k, v in r.metrics.items()))
+    click.echo(_albedo_line(r))
     c = r.convergence
     click.echo(f"# {c['evaluations']} model evaluations in {c['time_s']:.2f} s, "
                f"{len(c['starts'])} starts, {c['n_samples']} samples")
     fixed_args = " ".join(f"-p {k}={','.join(f'{x:.6g}' for x in v) if isinstance(v, list) else v}"
                           for k, v in d["params"].items() if v is not None)
     click.echo(f"# as a model: brdfkit eval {d['model']} {fixed_args}")
+
+
+#: Incidence angles (degrees) of the text output's albedo line.
+ALBEDO_LINE_DEG = (0.0, 30.0, 60.0, 75.0, 85.0)
+
+
+def _albedo_line(r) -> str:
+    """'# albedo model/target: 0: 0.2/0.19, ...' (the channels' mean) at ALBEDO_LINE_DEG."""
+    th = list(np.asarray(r.theta_deg, dtype=float))
+    a_m = np.asarray(r.albedo_model).reshape(len(th), -1).mean(axis=1)
+    a_t = np.asarray(r.albedo_target).reshape(len(th), -1).mean(axis=1)
+    parts = [f"{t:g}: {a_m[th.index(t)]:.3g}/{a_t[th.index(t)]:.3g}"
+             for t in ALBEDO_LINE_DEG if t in th]
+    return "# albedo model/target (mean of the channels) at theta_i deg: " + ", ".join(parts)
 
 
 def _batch(models, targets, *, param, start, pump, times, loss, procedure, seed, theta_max, as_json,

@@ -23,6 +23,7 @@ from brdfkit import _io
 from brdfkit.cli._common import build_model, emit_json, model_options
 from brdfkit.errors import BrdfkitError
 from brdfkit.render import MAX_SIZE, SUFFIXES, exposure_phi0, render_sphere, save_render
+from brdfkit.render.silhouette import DEFAULT_ANTIALIAS, MAX_ANTIALIAS
 
 __all__ = ["render_group", "sphere_cmd", "parse_exposure"]
 
@@ -68,6 +69,10 @@ def render_group() -> None:
                    "takes none.")
 @click.option("--seed", type=int, default=0, show_default=True,
               help="Sampler seed of --engine mitsuba (the render is deterministic given it).")
+@click.option("--antialias", type=int, default=None, metavar="N",
+              help=f"Direct engine: sub-samples per axis of each pixel the sphere's rim "
+                   f"crosses, averaged (1 to {MAX_ANTIALIAS}; default {DEFAULT_ANTIALIAS}: "
+                   "a smooth silhouette); 1 evaluates every pixel at its centre only.")
 @click.option("--exposure", default="phi0", show_default=True, metavar="K|phi0|peak",
               help="PNG only: display value = sRGB(min(1, K x radiance)). phi0: K = 1/peak "
                    "of the same sphere lit at phi_L = 0 (Lewis's rule: held constant across "
@@ -77,14 +82,22 @@ def render_group() -> None:
                    "float64). Written atomically.")
 @click.option("--json", "as_json", is_flag=True, help="Print the render's metadata as JSON.")
 def sphere_cmd(model, param, compensate, pump, times, phi_l, ambient, irradiance, size, engine,
-               spp, seed, exposure, out, as_json):
+               spp, seed, antialias, exposure, out, as_json):
     """Render MODEL on Lewis's sphere test configuration (Lewis 1993, Fig. 2).
 
     An S x S orthographic image of the unit sphere seen from +z, one
     directional light at phi_L from the viewer and an optional uniform
     ambient radiance; radiance E f_r(L, V) max(N.L, 0) + L_a rho(V) at each
-    pixel centre, 0 outside the disc (docs/rendering.md).
+    pixel centre (the rim's pixels: the mean of --antialias^2 sub-samples), 0 outside
+    the disc (docs/rendering.md).
     """
+    if engine == "mitsuba" and antialias is not None:
+        raise BrdfkitError(f"--antialias {antialias}: the mitsuba engine averages every "
+                           "pixel's area itself; drop --antialias (it is for --engine direct)")
+    if antialias is not None and not 1 <= antialias <= MAX_ANTIALIAS:
+        raise BrdfkitError(f"--antialias must be an integer from 1 to {MAX_ANTIALIAS}; got "
+                           f"{antialias}")
+    aa = {} if engine == "mitsuba" else {"antialias": antialias or DEFAULT_ANTIALIAS}
     if engine == "direct" and spp is not None:
         raise BrdfkitError(f"--spp {spp}: the direct engine is exact and takes no samples; "
                            "drop --spp (it is for --engine mitsuba)")
@@ -104,7 +117,8 @@ def sphere_cmd(model, param, compensate, pump, times, phi_l, ambient, irradiance
     _io.check_output_path(out, option="--out", suffixes=SUFFIXES)  # before any work
     m = build_model(model, param, pump, times, compensate)
     result = render_sphere(m, phi_l=math.radians(phi_l), ambient=ambient,
-                           irradiance=irradiance, size=size, engine=engine, spp=spp, seed=seed)
+                           irradiance=irradiance, size=size, engine=engine, spp=spp, seed=seed,
+                           **aa)
     k, how = None, ""
     if out.lower().endswith(".png"):
         if rule == "phi0":

@@ -175,7 +175,8 @@ class CompensatedBRDF(DerivedBRDF):
             citation=f"{base.citation}; compensated: {spec.citation}",
             summary=f"{base.name} with energy compensation ({spec.key}; {own})",
             reciprocal=base.reciprocal and spec.keeps_reciprocity,
-            has_sampler=base.has_sampler, isotropic=True, has_delta=base.has_delta,
+            has_sampler=base.has_sampler, isotropic=True,
+            mirror_symmetric=base.mirror_symmetric, has_delta=base.has_delta,
             width_param=base.width_param, kernel=kernel)
         self._driver = driver
         # the base's channels (a material declares them by its packed rows, not by colour

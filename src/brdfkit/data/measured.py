@@ -126,15 +126,15 @@ class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
     interpolant's albedo).
 
     Reciprocal by construction (the φ_d fold maps the swapped pair to the same
-    bin); f depends on the azimuths only through φ_i − φ_o (φ_h is dropped), and
-    is even in it — ``isotropic`` True, so the albedo engine integrates half the
-    azimuths — only when the table equals its mirror image, bin φ_d ↔ bin
-    179 − φ_d (:func:`_mirror_symmetric`; a mirrored pair's φ_d folds to
-    π − φ_d). A table of a reciprocal isotropic function is; a table of a
-    non-reciprocal one (each bin holds f(ω_i, ω_o) of its own centre only) or a
-    noisy measurement is not, and declares ``isotropic`` False (the engine then
-    integrates all azimuths: halving cost 1.1 % of the albedo of a tabulated
-    Lewis Phong at θ_i = 20° while reporting 3e-6 error).
+    bin); f depends on the azimuths only through φ_i − φ_o (φ_h is dropped):
+    ``isotropic`` True. It is even in φ_i − φ_o — ``mirror_symmetric`` True, so the
+    albedo engine integrates half the azimuths — only when the table equals its
+    mirror image, bin φ_d ↔ bin 179 − φ_d (:func:`_mirror_symmetric`; a mirrored
+    pair's φ_d folds to π − φ_d). A table of a reciprocal isotropic function is; a
+    table of a non-reciprocal one (each bin holds f(ω_i, ω_o) of its own centre
+    only) or a noisy measurement is not, and declares ``mirror_symmetric`` False
+    (the engine then integrates all azimuths: halving cost 1.1 % of the albedo of
+    a tabulated Lewis Phong at θ_i = 20° while reporting 3e-6 error).
 
     Sampling: from the table's own values (:mod:`brdfkit.data.sampler`: per-θ_o
     bilinear half-vector tables of f̄ cos θ_i mixed with the cosine), built on
@@ -178,7 +178,7 @@ class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
             values={"lookup": lookup}, citation=citation,
             summary=f"tabulated material ({table.source}), MERL grid 90x90x180",
             reciprocal=True, has_sampler=True, kernel=_measured_kernel,
-            isotropic=_mirror_symmetric(values))
+            isotropic=True, mirror_symmetric=_mirror_symmetric(values))
         self.n_channels = 3
         # one bin computation per pair for all channels
         self._driver = _table_driver(self._values["lookup"])
@@ -203,6 +203,12 @@ class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
 
     def lobes(self):
         return [Lobe("diffuse", 0.5 * math.pi), Lobe("half", self._width)]
+
+    def provenance(self) -> str:
+        """Verdicts on this model are verdicts on the table and its lookup (docstring)."""
+        return (f"the tabulated values of {self.table.source} ({self.values['lookup']} "
+                "lookup on the MERL grid): reciprocal by the grid's fold, whatever was "
+                "measured; its albedo is the table's")
 
     def with_params(self, **changes) -> MeasuredBRDF:
         unknown = set(changes) - {"lookup"}

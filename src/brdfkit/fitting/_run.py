@@ -30,7 +30,7 @@ from brdfkit.fitting._pumped import hold_scale
 from brdfkit.fitting._records import Convergence, StageRecord, StartRecord
 from brdfkit.fitting._result import FitResult, make_result
 from brdfkit.fitting._simplex import search_simplex
-from brdfkit.fitting._space import Z_MAX, ParameterSpace
+from brdfkit.fitting._space import BOUND_LOSS_RTOL, Z_MAX, ParameterSpace
 from brdfkit.fitting._starts import shape_starts
 from brdfkit.fitting.losses import Loss
 from brdfkit.fitting.samples import merl_samples
@@ -59,9 +59,6 @@ POLISH_MIN_EVALS = 600
 #: of 8,134; stage (iii) polishes on the fit's own samples. The time per evaluation is then
 #: mostly fixed costs (model set-up, linear solves), so coarser cells gain little.
 SEARCH_STRIDES = (9, 45)
-#: A coordinate whose move to its bound changes the final loss by less than this relative
-#: amount is reported at that bound (the data cannot tell it from the bound).
-BOUND_LOSS_RTOL = 1e-4
 #: The stages a procedure may list, in the order they must run.
 STAGES = ("first_guess", "hold_inert", "find_linear", "closed_form", "loss_scale",
           "root_start", "shape_search", "polish", "bound_polish")
@@ -497,9 +494,10 @@ class FitRun:
         n0 = self.n_evals()
         before = self.prob.loss_at(self.values)
         start = self.values
-        for c in held:
+        for c in held:  # at their bounds; an inert one held where it is
             side = flat[c.label][0] if c.label in flat else c.at_bound(space.x(self.values, c))
-            start = space.point([Z_MAX if side == "upper" else -Z_MAX], [c], start)
+            if side != "inert":
+                start = space.point([Z_MAX if side == "upper" else -Z_MAX], [c], start)
         steps = (0.1 if held else 1.0) * space.steps(start, rest)
         end, val, limit = self._polish_run(rest, start, steps)
         if val <= before:
@@ -515,23 +513,35 @@ class FitRun:
     def flat_to_bound(self, values, coords):
         """Coordinates the loss cannot tell from a bound: moved to the bound (z = ±Z_MAX)
         the loss rises by at most :data:`BOUND_LOSS_RTOL` relative (or falls: then the
-        bound is taken). Returns (values, {label: (side, bound, relative loss change)})."""
+        bound is taken). A coordinate the loss cannot tell from *either* bound (of a finite
+        range, not at one) is ``"inert"``: the data do not determine it (e.g. the exponent
+        of a lobe of zero weight), and it stays where it is. Returns (values, {label:
+        (side, bound, relative loss change)}), side "lower", "upper" or "inert" (bound
+        None, the larger of the two changes)."""
         prob, space = self.prob, self.space
         best = prob.loss_at(values)
         flat = {}
         if not math.isfinite(best):
             return values, flat
         for c in coords:
-            for side, z in (("lower", -Z_MAX), ("upper", Z_MAX)):
-                if c.transform == "identity" or (side == "upper" and math.isinf(c.upper)):
-                    continue
-                if c.at_bound(space.x(values, c)) == side:
-                    continue  # already there (reported by the exact test)
-                moved = space.point([z], [c], values)
-                lb = prob.loss_at(moved)
-                if lb <= best * (1.0 + BOUND_LOSS_RTOL):
-                    flat[c.label] = (side, c.to_x(z), (lb - best) / best if best > 0 else 0.0)
-                    if lb < best:
-                        values, best = moved, lb
-                    break
+            if c.transform == "identity":
+                continue
+            sides = [(side, z) for side, z in (("lower", -Z_MAX), ("upper", Z_MAX))
+                     if not (side == "upper" and math.isinf(c.upper))]
+            at = c.at_bound(space.x(values, c))
+            tried = []  # (side, z, moved values, loss there) for the sides not already at
+            for side, z in sides:
+                if at != side:  # already there: reported by the exact test
+                    moved = space.point([z], [c], values)
+                    tried.append((side, z, moved, prob.loss_at(moved)))
+            level = [t for t in tried if t[3] <= best * (1.0 + BOUND_LOSS_RTOL)]
+            if len(sides) == 2 and at is None and len(level) == 2:
+                change = max(abs(t[3] - best) for t in level) / best if best > 0 else 0.0
+                flat[c.label] = ("inert", None, change)
+                continue
+            if level:
+                side, z, moved, lb = level[0]
+                flat[c.label] = (side, c.to_x(z), (lb - best) / best if best > 0 else 0.0)
+                if lb < best:
+                    values, best = moved, lb
         return values, flat

@@ -40,12 +40,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Coord", "ParameterSpace", "LOG_FLOOR", "BOUND_TOL", "Z_MAX"]
+__all__ = ["Coord", "ParameterSpace", "LOG_FLOOR", "BOUND_TOL", "BOUND_LOSS_RTOL", "Z_MAX"]
 
 #: Stands for a lower bound of 0 in the log reparametrisation.
 LOG_FLOOR = 1e-6
 #: A coordinate is "at a bound" when σ(z) is within this of 0 or 1 (log: of L₀/L₁).
 BOUND_TOL = 1e-6
+#: A coordinate whose move to its bound changes the final loss by less than this relative
+#: amount is reported at that bound (the data cannot tell it from the bound); one the loss
+#: cannot tell from either bound is reported inert (FitRun.flat_to_bound).
+BOUND_LOSS_RTOL = 1e-4
 #: σ(±30) = 1 − 9e-14: z is clipped there (the bound to double precision).
 Z_MAX = 30.0
 _Z_MAX = Z_MAX

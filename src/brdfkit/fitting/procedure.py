@@ -98,9 +98,12 @@ steps, which travels along a long valley where the polish's small simplex
 crawled. Bounds are checked after the last stage: a coordinate at a bound, or
 one the loss cannot tell from a bound (moved there the loss rises by less than
 :data:`BOUND_LOSS_RTOL` relative; the bound is taken if the loss falls), is
-reported (``at_bounds``, status ``at_bound``, named in the message) — never a
-plain "converged". Every stage record lists the coordinates at a bound after
-it.
+reported (``at_bounds``, status ``at_bound``, named in the message with its value
+and which bound) — never a plain "converged". One the loss cannot tell from *either*
+bound of a finite range is not at a bound but **inert** (the data do not determine
+it: the exponent of a lobe whose weight is 0): it stays where the fit left it, is
+listed in ``convergence.inert`` and named in the message as inert. Every stage
+record lists the coordinates at a bound after it.
 
 Procedures as data
 -------------------

@@ -123,7 +123,9 @@ class BRDF:
     a default; engines read only these and never name a model:
 
     - :attr:`isotropic` — f depends on the azimuths only through their
-      difference and is mirror-symmetric about the plane of incidence.
+      difference (rotation invariance about the normal).
+    - :attr:`mirror_symmetric` — f is moreover even in that difference
+      (mirror symmetry about the plane of incidence), read with :attr:`isotropic`.
     - :attr:`kernel`, :attr:`packed`, :attr:`n_channels` — the compiled formula
       and its packed parameters (``kernel is None``: the model evaluates in
       :meth:`eval` itself, e.g. a pumped model with a user g).
@@ -138,6 +140,8 @@ class BRDF:
       (:class:`brdfkit._dual.Formulas`), or None (the default).
     - :meth:`fresnel_split` — the white (F = 1) form and F₀, F_avg of a model with a
       Fresnel factor, or None (the default: the model is its own white form).
+    - :meth:`provenance` — what a verdict on the model is a verdict on, when that is a
+      representation of data (a surrogate, a table), or None (the default: a formula).
 
     Models built from other models (pumped, measured, fitted, wrapped) derive
     from :class:`DerivedBRDF`, which passes through the same set-up.
@@ -158,10 +162,17 @@ class BRDF:
     #: The compiled scalar kernel ``kernel(ix, iy, iz, ox, oy, oz, p) -> float`` (module
     #: docstring); None for a model that evaluates in NumPy (it overrides :meth:`eval`).
     kernel: Callable | None = None
-    #: Whether f(ω_i, ω_o) depends on the azimuths only through φ_i − φ_o and is even in
-    #: it (mirror symmetry about the plane of incidence). The albedo engine then integrates
-    #: half the azimuths and doubles; pumping needs it (the albedo is a function of θ_i).
+    #: Whether f(ω_i, ω_o) depends on the azimuths only through φ_i − φ_o (rotation
+    #: invariance about the normal). Pumping and compensation need it (the albedo is then a
+    #: function of θ_i alone); analyses then evaluate at φ_i = 0.
     isotropic: ClassVar[bool] = True
+    #: Whether f(ω_i, ω_o) is moreover even in φ_i − φ_o: unchanged when both directions are
+    #: mirrored in the plane of incidence. Only then does the albedo engine integrate half
+    #: the azimuths and double, and the reciprocity check try one side of the plane. A
+    #: rotation-invariant model need not be even: a net fitted to measured data (NBRDF), a
+    #: noisy measured table, a chiral formula. Every registered model that claims it is
+    #: checked numerically by the registry-wide tests.
+    mirror_symmetric: ClassVar[bool] = True
     #: Kinks of ω_o ↦ f(ω_i, ω_o) on curves known in closed form, made panel edges by the
     #: albedo engine in every frame: ``"nv=nl"`` (a max(N·L, N·V) in the formula, e.g.
     #: Neumann eq. 22) and ``"vgroove"`` (the branches of the V-groove shadowing
@@ -476,6 +487,14 @@ class BRDF:
         """
         return None
 
+    def provenance(self) -> str | None:
+        """Where the model's values come from when a verdict on it is a verdict on that
+        representation rather than on a formula: a measured material's surrogate (a fitted
+        net need not be reciprocal though the material is), a tabulated file. The
+        plausibility check adds it to its notes. Default: None (a formula: its verdicts
+        are the formula's)."""
+        return None
+
     def formulas(self) -> Formulas | None:
         """eval, sample and pdf as formulas of :mod:`brdfkit._dual` (the Mitsuba bridge traces
         them), or None: the bridge then calls :meth:`eval`/:meth:`sample`/:meth:`pdf`."""
@@ -525,7 +544,7 @@ class DerivedBRDF(BRDF):
         The parameters this model exposes (e.g. a pumped model: its root's).
     values : dict
         Their values (validated again against *params*).
-    reciprocal, has_sampler, isotropic, has_delta : bool
+    reciprocal, has_sampler, isotropic, mirror_symmetric, has_delta : bool
         The model's claims (see :class:`BRDF`).
     width_param : str or None
         The parameter a half-angle ``beta`` converts to.
@@ -538,9 +557,9 @@ class DerivedBRDF(BRDF):
 
     def __init__(self, *, name: str, params, values: dict, citation: str = "",
                  summary: str = "", reciprocal: bool, has_sampler: bool = False,
-                 isotropic: bool = True, has_delta: bool = False,
-                 width_param: str | None = None, kernel: Callable | None = None,
-                 packed=None):
+                 isotropic: bool = True, mirror_symmetric: bool = True,
+                 has_delta: bool = False, width_param: str | None = None,
+                 kernel: Callable | None = None, packed=None):
         self.name = str(name)
         self.params = tuple(params)
         self.citation = citation
@@ -548,6 +567,7 @@ class DerivedBRDF(BRDF):
         self.reciprocal = bool(reciprocal)
         self.has_sampler = bool(has_sampler)
         self.isotropic = bool(isotropic)
+        self.mirror_symmetric = bool(mirror_symmetric)
         self.has_delta = bool(has_delta)
         self.width_param = width_param
         self.kernel = kernel

@@ -152,7 +152,7 @@ class PumpedBRDF(DerivedBRDF):
                       + ", ".join(_G_EQ.get(s, "a user g (eq. 17)") for s in self.stages)),
             summary=f"{root.name} with its albedo pumped up ({', '.join(self.stages)})",
             reciprocal=True, has_sampler=base.has_sampler, width_param=root.width_param,
-            kernel=kernel)
+            mirror_symmetric=base.mirror_symmetric, kernel=kernel)
         self.albedo_kinks = base.albedo_kinks  # f/g has f's kinks (and g's: albedo_kinks_nv)
         self.albedo_kink_mus = self._kink_mus()
 

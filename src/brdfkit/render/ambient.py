@@ -99,7 +99,8 @@ class TransposedBRDF(DerivedBRDF):
         super().__init__(name=f"{base.name}^T", params=base.params, values=base.values,
                          citation=base.citation, summary=f"{base.name} with wi and wo exchanged",
                          reciprocal=base.reciprocal, has_sampler=False,
-                         isotropic=base.isotropic, has_delta=base.has_delta, kernel=kernel,
+                         isotropic=base.isotropic, mirror_symmetric=base.mirror_symmetric,
+                         has_delta=base.has_delta, kernel=kernel,
                          packed=base.packed)
         self.albedo_kinks = base.albedo_kinks
 

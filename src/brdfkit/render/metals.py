@@ -242,7 +242,8 @@ class FresnelWeightedBRDF(DerivedBRDF):
             citation=f"{base.citation}; times conductor Fresnel F(L.H; n, k)",
             summary=f"{base.name} times the conductor Fresnel reflectance at L.H",
             reciprocal=base.reciprocal, has_sampler=base.has_sampler,
-            isotropic=base.isotropic, width_param=None, kernel=None)
+            isotropic=base.isotropic, mirror_symmetric=base.mirror_symmetric, width_param=None,
+            kernel=None)
         # F is smooth in the directions: f·F has the base's kinks, and so has its albedo
         self.albedo_kinks = base.albedo_kinks
         self.albedo_kink_mus = base.albedo_kink_mus

@@ -21,9 +21,11 @@ local frame (N = +z local): tangent T = the world x axis projected onto the
 tangent plane, T = (x̂ − N_x N)/√(1 − N_x²), and B = N × T. For an isotropic
 model any tangent gives the same value; for an anisotropic one this is the
 stated choice of tangent (the projected x axis). No sampling: the direct term
-is the model's kernel at the pixel centre, the ambient term the tabulated albedo integral with its
-stated error. The sphere does not shadow itself (it is convex) and there is
-no interreflection.
+is the model's kernel at the pixel centre, the ambient term the tabulated albedo
+integral with its stated error — except where the rim or the terminator crosses a
+pixel: it holds the mean of n × n sub-pixel samples (:mod:`brdfkit.render.silhouette`:
+smooth edges). The sphere does not shadow itself (it is convex) and there is no
+interreflection.
 
 A delta (perfectly specular) term (``has_delta``) reflects the directional
 light into exactly one direction, which no pixel centre receives: it adds
@@ -53,6 +55,14 @@ from brdfkit._cache import bounded_cache, memo
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models import BRDF
 from brdfkit.render.ambient import RHO_TOL, ambient_table
+from brdfkit.render.silhouette import (
+    DEFAULT_ANTIALIAS,
+    MAX_ANTIALIAS,
+    edge_pixels,
+    local_frame_pairs,
+    silhouette_pixels,
+    silhouette_samples,
+)
 from brdfkit.status import STATUS
 
 __all__ = ["SphereRender", "render_sphere", "sphere_geometry", "exposure_phi0", "MAX_SIZE",
@@ -60,6 +70,9 @@ __all__ = ["SphereRender", "render_sphere", "sphere_geometry", "exposure_phi0", 
 
 #: Largest image side: 8192² pixels of 3 channels are 1.6 GB of float64 radiance.
 MAX_SIZE = 8192
+#: Largest θ_V the ambient table is built to for the rim's sub-samples (89.9°: the last
+#: 0.1° of the rim is under 2e-6 of the radius wide, far below a pixel at any size).
+RIM_THETA_MAX = math.radians(89.9)
 #: Engines of :func:`render_sphere`; ``mitsuba`` (Monte Carlo) is planned (issue 11 §3).
 ENGINES = ("direct", "mitsuba")
 #: Default samples per pixel of the Monte-Carlo engine.
@@ -78,7 +91,8 @@ class SphereRender:
         in W/(m²·sr) give W/(m²·sr)); C = the model's channel count (1 for a
         scalar model). 0 outside the disc.
     mask : ndarray of bool (S, S)
-        The disc: pixels whose centre lies on the sphere.
+        The disc: pixels whose centre lies on the sphere. With ``antialias`` > 1 the rim
+        pixels just outside it hold the sphere's share of their area (not 0).
     model : dict
         ``model.to_dict()``.
     phi_l : float
@@ -123,6 +137,7 @@ class SphereRender:
     seed: int | None = None
     mc_error: np.ndarray | None = None
     passes: int | None = None
+    antialias: int = 1
 
     @property
     def success(self) -> bool:
@@ -160,6 +175,7 @@ class SphereRender:
                 "ambient_error": self.ambient_error, "ambient_message": self.ambient_message,
                 "success": self.success, "peak": self.peak, "spp": self.spp,
                 "seed": self.seed, "status": int(self.status), "message": self.message,
+                "antialias": self.antialias,
                 **({} if self.engine == "direct" else
                    {"passes": self.passes, "mc_error_max": self.mc_error_max})}
 
@@ -322,7 +338,8 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
                   ambient: float = 0.0, irradiance: float = 1.0,
                   size: int = 256, engine: str = "direct", spp: int | None = None,
                   seed: int = 0, variant: str = "llvm_ad_rgb",
-                  rho_tol: float = RHO_TOL, passes: int | None = None) -> SphereRender:
+                  rho_tol: float = RHO_TOL, passes: int | None = None,
+                  antialias: int = DEFAULT_ANTIALIAS) -> SphereRender:
     """Render Lewis's sphere test configuration exactly.
 
     Parameters
@@ -357,6 +374,14 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
     rho_tol : float, keyword-only
         Accuracy goal of ρ(V) when L_a > 0 (see
         :func:`brdfkit.render.ambient.ambient_table`; cached per model).
+    antialias : int, keyword-only
+        ``direct`` only: sub-samples per axis of each pixel the rim of the disc may cross
+        (1 … :data:`~brdfkit.render.silhouette.MAX_ANTIALIAS`, default
+        :data:`~brdfkit.render.silhouette.DEFAULT_ANTIALIAS`): such a pixel holds the
+        mean over its n × n cell midpoints of the radiance there (0 off the sphere), so
+        the silhouette is smooth — and so does a pixel the terminator N·L = 0 crosses
+        (where a 1/(N·L) shader jumps); 1 evaluates every pixel at its centre only (a
+        staircase rim). Other pixels are always exact at their centre.
 
     Returns
     -------
@@ -410,15 +435,28 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
         name, value = ("spp", spp) if spp is not None else ("passes", passes)
         raise ParameterError(f"{name}={value!r}: the direct engine is exact and takes no "
                              f"samples; drop {name} or use engine='mitsuba'")
+    if isinstance(antialias, bool) or not isinstance(antialias, int | np.integer) \
+            or not 1 <= antialias <= MAX_ANTIALIAS:
+        raise ParameterError(f"antialias must be an integer from 1 to {MAX_ANTIALIAS} "
+                             f"(sub-samples per axis of a rim pixel); got {antialias!r}")
     psi = float(light_azimuth)
     if not math.isfinite(psi):
         raise ParameterError(f"light_azimuth must be a finite angle in radians; got "
                              f"{light_azimuth!r}")
     L = (math.sin(phi) * math.cos(psi), math.sin(phi) * math.sin(psi), math.cos(phi))
+    # the pixels the rim or the terminator crosses (module silhouette), when anti-aliasing
+    rim = (edge_pixels(S, L) if antialias > 1 and E > 0.0 else silhouette_pixels(S)
+           if antialias > 1 else np.empty(0, dtype=np.int64))
+    sx, sy = silhouette_samples(S, rim, int(antialias))
     err, msg, ok = 0.0, "", True
     if L_a > 0.0:  # the ambient image first; the direct term is added to it
         # at least 1e-3 rad: the one pixel of a 1×1 image has θ_V = 0; the table needs a range
-        theta_max = max(math.acos(math.sqrt(max(1.0 - _max_r2(S), 0.0))), 1e-3)
+        # the rim's sub-samples reach closer to the horizon than any centre: the table
+        # covers them up to RIM_THETA_MAX (beyond, a sliver of < 1e-3 of a pixel's width,
+        # they read the table's last value)
+        r2 = max(_max_r2(S), float(np.max(np.where(sx * sx + sy * sy < 1.0,
+                                                   sx * sx + sy * sy, 0.0), initial=0.0)))
+        theta_max = min(max(math.acos(math.sqrt(max(1.0 - r2, 0.0))), 1e-3), RIM_THETA_MAX)
         table = ambient_table(model, theta_max=theta_max, tol=rho_tol)
         out = L_a * _rho_image(table, S, C)
         err, msg, ok = L_a * table.error, table.detail, table.success
@@ -435,12 +473,34 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
         if k:
             f = np.asarray(model.eval(wi[:k], wo[:k]), dtype=np.float64).reshape(k, C)
             _scatter(out, index[:k], E * cos_l[:k], np.ascontiguousarray(f))
+    if rim.size:
+        out = np.array(out)  # the ambient image is a cached read-only array
+        out[rim] = _rim_means(model, sx, sy, L, E, L_a, table if L_a > 0.0 else None,
+                              theta_max if L_a > 0.0 else 0.0, C)
     _, mask = _disc(S)
     status = (_CODES.NONFINITE if not np.all(np.isfinite(out))
               else _CODES.CONVERGED if ok else _CODES.LIMIT)
     return SphereRender(radiance=out.reshape(S, S, C), mask=mask, model=model.to_dict(),
                         phi_l=phi, ambient=L_a, irradiance=E, engine="direct",
-                        ambient_error=err, ambient_message=msg, status=status)
+                        ambient_error=err, ambient_message=msg, status=status,
+                        antialias=int(antialias))
+
+
+def _rim_means(model, sx, sy, L, E, L_a, table, theta_max, C) -> np.ndarray:
+    """(P, C): each rim pixel's mean over its sub-samples of E·f·max(N·L, 0) + L_a·ρ(θ_V),
+    0 at samples off the sphere (module silhouette)."""
+    inside, wi, wo, n_dot_l = local_frame_pairs(sx, sy, L)
+    vals = np.zeros((*sx.shape, C))
+    if wi.shape[0]:
+        v = np.zeros((wi.shape[0], C))
+        if E > 0.0:
+            f = np.asarray(model.eval(wi, wo), dtype=np.float64).reshape(-1, C)
+            v += E * np.maximum(n_dot_l, 0.0)[:, None] * f
+        if table is not None:
+            v += L_a * np.asarray(table(np.minimum(np.arccos(wo[:, 2]), theta_max)),
+                                  dtype=np.float64).reshape(-1, C)
+        vals[inside] = v
+    return vals.mean(axis=1)
 
 
 def exposure_phi0(model: BRDF, *, ambient: float = 0.0, irradiance: float = 1.0,
