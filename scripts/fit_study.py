@@ -73,5 +73,17 @@ def main(argv=None) -> int:
     return 0
 
 
+def run(argv=None) -> int:
+    """main(), with brdfkit's errors (a missing Ngan table, an unknown material) as one
+    line on stderr and exit status 2, as the brdfkit command prints them."""
+    from brdfkit.errors import BrdfkitError
+
+    try:
+        return main(argv)
+    except BrdfkitError as e:
+        print(f"fit_study.py: error: {e}", file=sys.stderr)
+        return 2
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run())

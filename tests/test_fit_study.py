@@ -144,3 +144,21 @@ def test_report_verdicts_from_synthetic_files(tmp_path):
                [_row(A, "l1", {"alpha": 0.3}, 1.2), _row(B, "l1", {"alpha": 0.8}, 2.5)])
     verdicts = {c["claim"][:20]: c["verdict"] for c in claims(read_study(d))}
     assert verdicts["the α-mix (eq. 3) fi"] == "not supported"
+
+
+def test_the_study_script_without_ngans_table_says_so_in_one_line(tmp_path):
+    # Regression (issue 20): `scripts/fit_study.py run` died with a raw traceback when the
+    # Ngan table's path was absent; now one line naming the path and the way round it.
+    import pathlib
+    import subprocess
+    import sys
+
+    script = pathlib.Path(__file__).resolve().parents[1] / "scripts" / "fit_study.py"
+    r = subprocess.run([sys.executable, str(script), "run", "--dir", str(tmp_path / "s"),
+                        "--materials", "merl:nickel", "--parts", "anchors", "--ngan",
+                        str(tmp_path / "absent.csv")], capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 2, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("fit_study.py: error: ngan_csv"), r.stderr
+    assert "absent.csv" in lines[0] and "--parts nielsen,neumann" in lines[0]

@@ -202,7 +202,8 @@ def run_study(directory, *, materials, parts=PARTS, workers: int = 1, ngan_csv=N
     ngan = read_ngan_table(ngan_csv) if (ngan_csv and "anchors" in parts) else None
     if "anchors" in parts and ngan is None:
         raise BrdfkitError("the anchors part needs ngan_csv: the path of "
-                           "merl_fits_lafortune_ngan2005.csv (see SOURCES.md)")
+                           "merl_fits_lafortune_ngan2005.csv (see SOURCES.md; --ngan PATH), "
+                           "or leave the part out (--parts nielsen,neumann)")
     reports = []
     for b in study_batches(materials, parts=parts, ngan_names=ngan):
         os.makedirs(os.path.dirname(b.path(directory)), exist_ok=True)
@@ -340,7 +341,8 @@ def read_ngan_table(path) -> dict:
     p = os.fspath(path)
     if not os.path.exists(p):
         raise BrdfkitError(f"ngan_csv {p!r} does not exist (merl_fits_lafortune_ngan2005.csv,"
-                           " see shared/data/measured/SOURCES.md)")
+                           " see shared/data/measured/SOURCES.md; --ngan PATH), or leave the "
+                           "anchors part out (--parts nielsen,neumann)")
     out = {}
     with open(p, newline="", encoding="utf-8") as fh:
         for r in csv.DictReader(fh):
