@@ -254,3 +254,25 @@ def test_readme_commands_are_marked():
         after = readme.split(marker, 1)[1].lstrip()
         assert after.startswith("```bash\n"), marker
         assert after.split("\n")[1].startswith(needle), after.split("\n")[1]
+
+
+def test_models_takes_a_name_and_shows_parameter_docs_under_a_header():
+    # issue 20: `brdfkit models ward` was an error (while `materials SPEC` filters) and the
+    # text output had no header and omitted the parameter docs that --json has
+    r = run("models", "ward")
+    assert r.exit_code == 0, r.output
+    lines = r.output.splitlines()
+    assert lines[0].startswith("ward  (aliases: ")
+    header = next(ln for ln in lines if ln.strip().startswith("parameter"))
+    assert header.split() == ["parameter", "default", "bounds", "unit", "meaning"]
+    docs = {p["name"]: p["doc"] for p in brdfkit.MODELS["ward"].describe()["params"]}
+    for name, doc in docs.items():
+        assert any(ln.split()[:1] == [name] and ln.rstrip().endswith(doc) for ln in lines), name
+    assert run("models", "ward92").output == r.output  # an alias names the same model
+    bad = run("models", "wardd")
+    assert bad.exit_code == 2 and "did you mean 'ward'" in bad.output
+    mat = run("models", "merl:nickel")
+    assert mat.exit_code == 2 and "brdfkit materials" in mat.output
+    # every model's table has the header too
+    every = run("models").output
+    assert every.count("parameter  ") >= len(brdfkit.MODELS) - 1

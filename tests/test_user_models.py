@@ -521,8 +521,8 @@ def test_cli_models_file_shows_isotropy_claims_and_parameters(files):
     (d,) = json.loads(r.output)
     assert d["claims"] == {"reciprocal": True, "energy_conserving": None}
     assert d["own_sampler"] and d["isotropic"] and d["source"] == str(files / "models.py")
-    r = run("models", "modified-phong")
-    assert r.exit_code == 2 and "takes a .py or .brdf file" in r.stderr
+    r = run("models", "modified-phong")  # a registered name shows that model (issue 20)
+    assert r.exit_code == 0 and r.output.startswith("modified-phong"), r.output
 
 
 def test_cli_commands_take_a_python_model(files, tmp_path):

@@ -37,30 +37,54 @@ def _param_row(p: dict) -> tuple[str, str, str, str]:
     return p["name"], default, bounds, f"{unit}{per}"
 
 
+#: The header of a parameter table (the columns of _param_row, then the doc).
+_PARAM_HEADER = ("parameter", "default", "bounds", "unit", "meaning")
+
+
+def _param_table(rows, header=_PARAM_HEADER) -> list[str]:
+    """Lines of a parameter table with its header, columns aligned (the last one free)."""
+    if not rows:
+        return ["      (no parameters)"]
+    rows = [header, *rows]
+    widths = [max(len(r[i]) for r in rows) for i in range(len(header) - 1)]
+    return ["      " + "  ".join([*(c.ljust(w) for c, w in zip(r, widths, strict=False)),
+                                   r[-1]]).rstrip() for r in rows]
+
+
 @click.command("models")
-@click.argument("file", required=False, metavar="[FILE]")
+@click.argument("spec", required=False, metavar="[NAME|FILE]")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON (a list of model descriptions).")
-def models_cmd(file: str | None, as_json: bool) -> None:
-    """List every registered model with its parameters, citation and claims;
-    with FILE (a .py or .brdf file, PATH.py:NAME for one of several), the models it defines.
+def models_cmd(spec: str | None, as_json: bool) -> None:
+    """List every registered model with its parameters, citation and claims; with NAME (a
+    registered name or alias) that model only; with FILE (a .py or .brdf file, PATH.py:NAME
+    for one of several), the models it defines.
 
     For each model: aliases, whether its formula claims to be reciprocal,
     whether it has an importance sampler, the citation (paper and equation),
-    and each parameter's default, bounds and unit. 'beta' (where listed) is
-    the lobe half-angle alternative to the width parameter, in degrees on the
+    and a table of its parameters: default, bounds, unit and meaning. 'beta' (where
+    listed) is the lobe half-angle alternative to the width parameter, in degrees on the
     command line. For a FILE: each parameter's kind and doc, the detected
     isotropy and why, the file's claims (reciprocity measured at the defaults
-    when not claimed), its sampler and notes.
+    when not claimed), its sampler and notes. Built-in materials: 'brdfkit materials'.
     """
-    if file is not None:
-        _file_models(file, as_json)
+    from brdfkit.spec import ModelSpec
+
+    if spec is not None and ModelSpec(spec).kind in ("python-file", "brdf-file"):
+        _file_models(spec, as_json)
         return
-    descriptions = [cls.describe() for cls in brdfkit.MODELS.values()]
+    if spec is not None and ModelSpec(spec).kind != "model":
+        raise BrdfkitError(f"brdfkit models takes a registered model name, a .py or a .brdf "
+                           f"file; {spec!r} is a material or a MERL file (brdfkit materials "
+                           "lists the built-in materials)")
+    classes = (list(brdfkit.MODELS.values()) if spec is None
+               else [brdfkit.models.resolve(spec)])  # an unknown name: one line, valid names
+    descriptions = [cls.describe() for cls in classes]
     if as_json:
         emit_json(descriptions)
         return
-    click.echo(f"{len(descriptions)} models (reciprocal = formula claims f(wi,wo) = f(wo,wi); "
-               "sampler = importance sampler beyond the cosine fallback)\n")
+    if spec is None:
+        click.echo(f"{len(descriptions)} models (reciprocal = formula claims f(wi,wo) = "
+                   "f(wo,wi); sampler = importance sampler beyond the cosine fallback)\n")
     for d in descriptions:
         aliases = f"  (aliases: {', '.join(d['aliases'])})" if d["aliases"] else ""
         click.echo(f"{d['name']}{aliases}")
@@ -68,13 +92,11 @@ def models_cmd(file: str | None, as_json: bool) -> None:
                    f"   cite: {d['citation']}")
         if d["summary"]:
             click.echo(f"    {d['summary']}")
-        rows = [_param_row(p) for p in d["params"]]
+        rows = [(*_param_row(p), p.get("doc") or "") for p in d["params"]]
         if d["beta"]:
-            rows.append(("beta", "-", "(0, 90)", f"deg (sets {d['beta']})"))
-        widths = [max(len(r[i]) for r in rows) for i in range(4)] if rows else []
-        for r in rows:
-            click.echo("      " + "  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True))
-                       .rstrip())
+            rows.append(("beta", "-", "(0, 90)", "deg", f"lobe half-angle; sets {d['beta']}"))
+        for line in _param_table(rows):
+            click.echo(line)
         click.echo("")
 
 
@@ -117,13 +139,9 @@ def _file_models(file: str, as_json: bool) -> None:
             click.echo(f"    cite: {d['citation']}")
         for note in d["notes"]:
             click.echo(f"    note: {note}")
-        rows = [(*_param_row(p)[:3], p["kind"], p["doc"]) for p in d["params"]]
-        widths = [max(len(r[i]) for r in rows) for i in range(5)] if rows else []
-        for r in rows:
-            click.echo("      " + "  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True))
-                       .rstrip())
-        if not rows:
-            click.echo("      (no parameters)")
+        rows = [(*_param_row(p)[:3], p["kind"], p["doc"] or "") for p in d["params"]]
+        for line in _param_table(rows, ("parameter", "default", "bounds", "kind", "meaning")):
+            click.echo(line)
         click.echo("")
 
 
