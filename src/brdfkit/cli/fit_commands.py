@@ -48,7 +48,8 @@ __all__ = ["fit_cmd"]
               default="l1", show_default=True, help="The loss minimised (docs/fitting.md).")
 @click.option("--procedure", type=click.Choice(list(PROCEDURES)),
               default="auto", show_default=True, help="The fitting procedure.")
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of random starts.")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Seed of the random starts, an integer >= 0.")
 @click.option("--starts", type=click.IntRange(min=1), default=3, show_default=True,
               help="Runs of the shape stage (first guess, defaults, random).")
 @click.option("--theta-max", "theta_max", type=click.FloatRange(0.0, 90.0, min_open=True),
