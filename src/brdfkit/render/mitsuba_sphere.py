@@ -52,9 +52,13 @@ import numpy as np
 from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
 from brdfkit.render.mitsuba_bridge import (
+    MITSUBA_MAX_SIZE,
     _mitsuba,
+    check_samples,
+    check_seed,
     irradiance_spectrum,
     mitsuba_bsdf,
+    render_bounded,
     use_variant,
     wavefront,
 )
@@ -129,11 +133,15 @@ def render_sphere_mitsuba(model: BRDF, *, phi_l: float = 0.0, ambient: float = 0
     irradiance : float
         E ≥ 0 of the directional light (on a surface facing it).
     size : int
-        S, the image is S×S pixels (1 … 4096).
+        S, the image is S×S pixels (1 … :data:`~brdfkit.render.mitsuba_bridge.MITSUBA_MAX_SIZE`
+        = 2048).
     spp : int
-        Samples per pixel (1 … 65536); the noise falls as 1/√spp.
+        Samples per pixel (1 … 65536, and S² × spp at most
+        :data:`~brdfkit.render.mitsuba_bridge.MAX_SAMPLES` = 2^30); the noise falls as
+        1/√spp. Memory is bounded: a render of more than 2^20 paths is split into calls
+        (:func:`~brdfkit.render.mitsuba_bridge.render_bounded`).
     seed : int
-        Mitsuba's sampler seed (the render is deterministic given it).
+        Mitsuba's sampler seed, 0 … 2^32 − 1 (the render is deterministic given it).
     variant : str
         ``llvm_ad_rgb`` (default), ``llvm_ad_mono``, ``llvm_ad_spectral`` or a
         ``scalar_*`` one (slow); an unavailable ``llvm_*`` variant falls back
@@ -206,11 +214,11 @@ def _check_args(model, *, phi_l, ambient, irradiance, size, spp, seed) -> None:
         if not (isinstance(value, (int, float)) and lo <= value <= hi and math.isfinite(value)):
             raise ParameterError(f"{name} must be a finite number in [{lo:g}, {hi:g}]; "
                                  f"got {value!r}")
-    for name, value, lo, hi in (("size", size, 1, 4096), ("spp", spp, 1, 65536)):
+    for name, value, lo, hi in (("size", size, 1, MITSUBA_MAX_SIZE), ("spp", spp, 1, 65536)):
         if not (isinstance(value, (int, np.integer)) and lo <= value <= hi):
             raise ParameterError(f"{name} must be an integer in [{lo}, {hi}]; got {value!r}")
-    if not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ParameterError(f"seed must be a non-negative integer; got {seed!r}")
+    check_seed(seed)
+    check_samples(int(size) ** 2, spp)
 
 
 def _render(model, jobs, *, phi_l, ambient, irradiance, size, variant, wavelengths,
@@ -226,6 +234,6 @@ def _render(model, jobs, *, phi_l, ambient, irradiance, size, variant, wavelengt
     images = []
     with contextlib.nullcontext() if bsdf.traced else wavefront():
         for spp, seed in jobs:
-            out = np.array(mi.render(scene, spp=int(spp), seed=int(seed)), dtype=np.float64)
+            out = render_bounded(scene, spp=spp, seed=seed, pixels=int(size) ** 2)
             images.append(out[:, :, None] if out.ndim == 2 else out)
     return images
