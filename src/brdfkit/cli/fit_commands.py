@@ -19,6 +19,7 @@ import click
 
 import brdfkit.cli._progress as _progress
 from brdfkit.cli._common import COMPENSATE_HELP, PARAM_HELP, emit_json
+from brdfkit.cli._group import Stopped
 from brdfkit.errors import BrdfkitError
 from brdfkit.fitting import LOSSES, PROCEDURES  # the registries' names (--loss, --procedure)
 from brdfkit.spec import COMPENSATE_CHOICES, PUMP_CHOICES, ModelSpec, canonical_name, parse_items
@@ -139,7 +140,7 @@ def fit_cmd(models, param, start, compensate, pump, times, to, loss, procedure, 
 def _batch(models, targets, *, param, start, pump, times, loss, procedure, seed, theta_max, as_json,
            plot, out, workers, scheduler) -> None:
     """``brdfkit fit MODEL... --to SPEC... --out FILE.csv``: one row per fit."""
-    from brdfkit.fitting.batch import Job, fit_row, run_batch
+    from brdfkit.fitting.batch import BatchInterrupted, Job, fit_row, run_batch
 
     if out is None:
         raise BrdfkitError(f"{len(models)} model(s) x {len(targets)} material(s) is a batch: "
@@ -165,8 +166,11 @@ def _batch(models, targets, *, param, start, pump, times, loss, procedure, seed,
     jobs = [Job(m, t, loss=loss, procedure=procedure, options=options)
             for m in models for t in targets]
     show = _progress.stderr_is_interactive()
-    with _progress.counter("fit", enabled=show) as progress:
-        report = run_batch(jobs, out=out, run_job=fit_row, workers=workers,
-                           scheduler=scheduler, progress=progress)
+    try:
+        with _progress.counter("fit", enabled=show) as progress:
+            report = run_batch(jobs, out=out, run_job=fit_row, workers=workers,
+                               scheduler=scheduler, progress=progress)
+    except BatchInterrupted as exc:  # Ctrl-C: one 'brdfkit: interrupted: ...' line, status 130
+        raise Stopped.interrupted(str(exc).removeprefix("interrupted: ")) from None
     click.echo(f"{report.out}: {report.done} fitted now, {report.skipped} already there, "
                f"{report.failed} failed, of {report.total} ({report.seconds:.1f} s)")

@@ -59,14 +59,23 @@ def check_fit_args(*, fixed, theta_max, seed, strides, max_evals, progress) -> t
 
 
 def check_samples(*, strides, theta_max) -> None:
-    """*theta_max* must leave at least one sample pair of the MERL grid at *strides*;
-    the error names the smallest theta_max that does."""
-    if theta_max is None or len(merl_samples(strides=strides, theta_max=theta_max)):
+    """*theta_max* must leave at least one sample pair of the MERL grid at *strides* and at
+    the shape search's coarser strides (``SEARCH_STRIDES``); the error names the smallest
+    theta_max that does."""
+    from brdfkit.fitting._run import SEARCH_STRIDES
+
+    if theta_max is None:
         return
-    s = merl_samples(strides=strides)
-    cos = np.minimum(s.wi[:, 2], s.wo[:, 2])
-    # rounded up to 1e-4 deg, so that the value printed does keep a pair
-    least = math.ceil(math.degrees(math.acos(float(np.clip(cos.max(), -1.0, 1.0)))) * 1e4) / 1e4
+    grids = {tuple(strides), tuple(max(int(a), b) for a, b in
+                                   zip(strides, SEARCH_STRIDES, strict=True))}
+    if all(len(merl_samples(strides=g, theta_max=theta_max)) for g in grids):
+        return
+    least = 0.0
+    for g in grids:
+        s = merl_samples(strides=g)
+        cos = float(np.clip(np.minimum(s.wi[:, 2], s.wo[:, 2]).max(), -1.0, 1.0))
+        least = max(least, math.degrees(math.acos(cos)))
+    least = math.ceil(least * 1e4) / 1e4  # rounded up, so that the value printed keeps a pair
     raise ParameterError(
         f"fit: theta_max = {theta_max:.6g} rad ({math.degrees(theta_max):.4g} deg) leaves no "
         f"sample pair (theta_i, theta_o <= theta_max) on the MERL grid at strides {strides}; "
