@@ -550,7 +550,7 @@ def test_bad_input(phong):
 
 def test_times_bounded(phong, phong_max):
     """times is bounded by MAX_TIMES (each stage tabulates the previous one's albedo with
-    the engine: 4 controlled stages of modified-phong take about a minute, 5 about 3); the
+    the engine: 4 controlled stages of modified-phong take 1-2.5 min, 5 about 3); the
     stages the model already has count; nothing is built before the check."""
     from brdfkit.pumping import MAX_TIMES
 

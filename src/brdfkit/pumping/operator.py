@@ -543,7 +543,7 @@ def _check_times(fn: str, model: BRDF, times) -> None:
             f"{fn}: times must be at most MAX_TIMES = {MAX_TIMES} pumpings in all{already}; "
             f"got times = {int(times)}. Each stage tabulates the previous stage's albedo with "
             "the albedo engine, so the cost grows much faster than the stages (4 controlled "
-            "pumpings of modified-phong take about a minute on 2 cores, 5 about 3), and more "
+            "pumpings of modified-phong take 1-2.5 min on 2 cores, 5 about 3), and more "
             "has little visible effect (the 4th pumping of the n = 20 Phong adds 0.005 to "
             "rho_hh)")
 
