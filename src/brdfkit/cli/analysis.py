@@ -332,8 +332,8 @@ def table2_cmd(as_json, as_md, models):
 @click.option("--spp", type=click.IntRange(min=1, max=4096), default=None, metavar="N",
               help="Monte-Carlo figures (neumann-fig8): samples per pixel (default 16; with "
                    "--size S, S x 0.75 S x N at most 2^30). Cost: 12 renders of S x 0.75 S x N "
-                   "samples at ~0.26 M samples/s on 2 cores (defaults: about a minute); "
-                   "memory stays under ~2 GB.")
+                   "paths of up to 6 bounces (Mitsuba traces ~0.26 M single-bounce samples/s "
+                   "on 2 cores); memory stays under ~2 GB.")
 @click.option("--size", type=click.IntRange(min=16, max=2048), default=None, metavar="S",
               help="Monte-Carlo figures (neumann-fig8): width of each panel in pixels "
                    "(default 320).")

@@ -30,7 +30,7 @@ from brdfkit.render.mitsuba_bridge import (
     SEED_LIMIT,
     check_samples,
 )
-from brdfkit.render.sphere import BYTES_PER_VALUE
+from brdfkit.render.sphere import BYTES_PER_VALUE, DEFAULT_SPP
 
 __all__ = ["render_group", "sphere_cmd", "parse_exposure"]
 
@@ -74,10 +74,11 @@ def render_group() -> None:
               help="direct: exact, deterministic. mitsuba: Monte Carlo through Mitsuba 3 "
                    "with brdfkit's sampler (pixel-area averages; noise ~ 1/sqrt(spp)).")
 @click.option("--spp", type=int, default=None, metavar="N",
-              help="Samples per pixel of --engine mitsuba (default 64, at most 65536 and "
-                   f"S² x N <= {MAX_SAMPLES:.3g} = 2^30); the direct engine takes none. Cost "
+              help=f"Samples per pixel of --engine mitsuba (default {DEFAULT_SPP}, at most "
+                   f"65536 and S² x N <= {MAX_SAMPLES:.3g} = 2^30); the direct engine takes "
+                   "none. Cost "
                    "(2 cores): ~0.26 M samples/s for most models, ~3 M/s for microfacet; "
-                   "memory stays under ~2.5 GB (renders are split into calls of 2^20 "
+                   "memory stays under ~3 GB (renders are split into calls of 2^20 "
                    "paths).")
 @click.option("--seed", type=click.IntRange(0, SEED_LIMIT - 1), default=0, show_default=True,
               help=f"Sampler seed of --engine mitsuba, 0 to {SEED_LIMIT - 1} (Mitsuba's seeds "
@@ -120,7 +121,7 @@ def sphere_cmd(model, param, compensate, pump, times, phi_l, ambient, irradiance
                                f"{MITSUBA_MAX_SIZE} pixels a side (one sample per pixel of "
                                f"{MITSUBA_MAX_SIZE}² is ~2.5 GB of paths); use a smaller "
                                "--size or --engine direct")
-        check_samples(size * size, 64 if spp is None else spp, size_name="--size")
+        check_samples(size * size, DEFAULT_SPP if spp is None else spp, size_name="--size")
     rule = parse_exposure(exposure)
     _io.check_output_path(out, option="--out", suffixes=SUFFIXES)  # before any work
     m = build_model(model, param, pump, times, compensate)

@@ -193,16 +193,24 @@ def render_sphere_mitsuba_passes(model: BRDF, *, phi_l: float = 0.0, ambient: fl
     k = int(k)
     counts = [int(spp) // k + (1 if j < int(spp) % k else 0) for j in range(k)]
     jobs = [(n, (k * int(seed) + j) % 2**32) for j, n in enumerate(counts)]  # Mitsuba: uint32
-    images = _render(model, jobs, phi_l=phi_l, ambient=ambient, irradiance=irradiance,
-                     size=size, variant=variant, wavelengths=wavelengths,
-                     illuminant=illuminant)
+    images = _render_each(model, jobs, phi_l=phi_l, ambient=ambient, irradiance=irradiance,
+                          size=size, variant=variant, wavelengths=wavelengths,
+                          illuminant=illuminant)
     if k == 1:
-        return images[0], None, 1
-    n = np.asarray(counts, dtype=np.float64).reshape(k, 1, 1, 1)
-    stack = np.stack(images)
-    mean = np.sum(n * stack, axis=0) / n.sum()
-    s2 = np.sum(n * (stack - mean) ** 2, axis=0) / (k - 1)
-    return mean, np.sqrt(s2 / n.sum()), k
+        return next(images), None, 1
+    # the sample-weighted mean and sum of squares, one pass image at a time (West 1979's
+    # weighted update), so that memory holds a few images, not K of them: S = sum n_k
+    # (x_k - mean)^2 after the last pass, s^2 = S / (K - 1) (module docstring)
+    mean, ss, total = None, None, 0.0
+    for n_k, image in zip(counts, images, strict=True):
+        total += n_k
+        if mean is None:
+            mean, ss = image, np.zeros_like(image)
+            continue
+        delta = image - mean
+        mean += (n_k / total) * delta
+        ss += n_k * delta * (image - mean)
+    return mean, np.sqrt(ss / (k - 1) / total), k
 
 
 def _check_args(model, *, phi_l, ambient, irradiance, size, spp, seed) -> None:
@@ -224,6 +232,15 @@ def _check_args(model, *, phi_l, ambient, irradiance, size, spp, seed) -> None:
 def _render(model, jobs, *, phi_l, ambient, irradiance, size, variant, wavelengths,
             illuminant) -> list[np.ndarray]:
     """One scene, rendered once per (spp, seed) of *jobs*: images (S, S, C) float64."""
+    return list(_render_each(model, jobs, phi_l=phi_l, ambient=ambient, irradiance=irradiance,
+                             size=size, variant=variant, wavelengths=wavelengths,
+                             illuminant=illuminant))
+
+
+def _render_each(model, jobs, *, phi_l, ambient, irradiance, size, variant, wavelengths,
+                 illuminant):
+    """As :func:`_render`, one image at a time (a generator: only the image being used is
+    held)."""
     mi, _ = _mitsuba()
     used = use_variant(variant)
     bsdf = mitsuba_bsdf(model, wavelengths=wavelengths)
@@ -231,9 +248,7 @@ def _render(model, jobs, *, phi_l, ambient, irradiance, size, variant, wavelengt
                                       ambient=ambient, size=size, variant=used,
                                       illuminant=illuminant))
     # the traced route renders in Dr.Jit's default symbolic mode, the other one per wavefront
-    images = []
-    with contextlib.nullcontext() if bsdf.traced else wavefront():
-        for spp, seed in jobs:
+    for spp, seed in jobs:
+        with contextlib.nullcontext() if bsdf.traced else wavefront():
             out = render_bounded(scene, spp=spp, seed=seed, pixels=int(size) ** 2)
-            images.append(out[:, :, None] if out.ndim == 2 else out)
-    return images
+        yield out[:, :, None] if out.ndim == 2 else out
