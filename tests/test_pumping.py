@@ -14,7 +14,7 @@ the registry-wide theorem check (a <= a* <= 1, reciprocity) pumps every
 reciprocal registered model's FIRST example once with g₁ and with g₂
 (He–Torrance, whose kernel is a slow series, with g₁ only) at
 θ = 0, 30, 60, 80, 89, 89.9°; other examples are the same formulas with
-other numbers. Repeated pumping (1–5 stages, g₁ and g₂) is checked
+other numbers. Repeated pumping (1–4 stages, g₁ and g₂) is checked
 on the paper's n = 20 Phong (modified-phong) and Blinn
 (phong-blinn-reciprocal): these are the cases the paper plots and the ones
 whose albedo has kinks (g₂) that the tables must resolve.
@@ -82,19 +82,19 @@ def blinn():
 
 @pytest.fixture(scope="module")
 def phong_max(phong):
-    return pump_sequence(phong, "max", times=5)
+    return pump_sequence(phong, "max", times=4)
 
 
 @pytest.fixture(scope="module")
 def blinn_max(blinn):
-    return pump_sequence(blinn, "max", times=5)
+    return pump_sequence(blinn, "max", times=4)
 
 
 @pytest.fixture(scope="module")
 def blinn_ctrl(blinn):
-    # 5 stages: the tables are split at the albedo's kinks (where a(θ) crosses cos θ),
+    # 4 stages (MAX_TIMES): the tables are split at the albedo's kinks (where a(θ) crosses cos θ),
     # so each builds in ~1 s (test_table_split_at_kinks)
-    return pump_sequence(blinn, "controlled", times=5)
+    return pump_sequence(blinn, "controlled", times=4)
 
 
 # --------------------------------------------------------------------------- the model object
@@ -312,9 +312,11 @@ def _f_over_g_definition(model, wi, wo):
 
 
 @pytest.mark.parametrize("which,chained", [
-    # stage 5 tabulates the 4x-pumped Phong, whose albedo has a real dip (6e-5 at 25 deg)
-    ("phong_max", [True, True, True, True, False]),
-    ("blinn_ctrl", [True] * 5),
+    ("phong_max", [True] * 4),
+    ("blinn_ctrl", [True] * 4),
+    # a chained stage, then an unchained one: stage 2 tabulates the g2-pumped default
+    # modified-phong (rho_d = 0.2), whose albedo is not monotone
+    ("phong_default_ctrl", [True, False]),
     # Cook-Torrance's albedo rises toward grazing (Fresnel): every stage has two lookups
     ("cook_torrance_ctrl", [False, False]),
 ])
@@ -324,6 +326,8 @@ def test_chain_kernel_is_the_stagewise_definition(which, chained, request):
     stage-by-stage definition within the lookup error, and never exceeds it (a* <= 1 kept)."""
     if which == "cook_torrance_ctrl":
         seq = pump_sequence(brdfkit.model("cook-torrance"), "controlled", times=2)
+    elif which == "phong_default_ctrl":
+        seq = pump_sequence(brdfkit.model("modified-phong"), "controlled", times=2)
     else:
         seq = request.getfixturevalue(which)
     assert [m.chained for m in seq[1:]] == chained
@@ -341,7 +345,7 @@ def test_chain_kernel_is_the_stagewise_definition(which, chained, request):
 # --------------------------------------------------------------------------- the theorem
 @pytest.mark.parametrize("which", ["phong_max", "blinn_max", "blinn_ctrl"])
 def test_theorem_repeated(which, request):
-    """a_(k-1) <= a_k <= 1 for k = 1..5 (eqs. 18-19, derived); Phong's g₂ is its g₁."""
+    """a_(k-1) <= a_k <= 1 for k = 1..4 (eqs. 18-19, derived); Phong's g₂ is its g₁."""
     seq = request.getfixturevalue(which)
     prev = _alb(seq[0], TH_CHECK)
     for k in range(1, len(seq)):
@@ -546,19 +550,19 @@ def test_bad_input(phong):
 
 def test_times_bounded(phong, phong_max):
     """times is bounded by MAX_TIMES (each stage tabulates the previous one's albedo with
-    the engine: 8 stages take about a minute, 16 did not finish in 9); the stages the
-    model already has count; nothing is built before the check."""
+    the engine: 4 controlled stages of modified-phong take 1-2.5 min, 5 about 3); the
+    stages the model already has count; nothing is built before the check."""
     from brdfkit.pumping import MAX_TIMES
 
-    assert MAX_TIMES == 8
-    with pytest.raises(ParameterError, match=r"times must be at most MAX_TIMES = 8 .*"
+    assert MAX_TIMES == 4
+    with pytest.raises(ParameterError, match=r"times must be at most MAX_TIMES = 4 .*"
                                              r"got times = 100"):
         pump(phong, "controlled", times=100)
-    with pytest.raises(ParameterError, match=r"MAX_TIMES = 8 .*already has 1 stage\).*"
-                                             r"got times = 8"):
+    with pytest.raises(ParameterError, match=r"MAX_TIMES = 4 .*already has 1 stage\).*"
+                                             r"got times = 4"):
         pump(phong_max[1], "max", times=MAX_TIMES)
-    with pytest.raises(ParameterError, match=r"pump_sequence: times .*MAX_TIMES = 8"):
-        pump_sequence(phong, "max", times=9)
+    with pytest.raises(ParameterError, match=r"pump_sequence: times .*MAX_TIMES = 4"):
+        pump_sequence(phong, "max", times=5)
 
 def test_cli_pump(phong):
     import json

@@ -252,7 +252,7 @@ def test_parse_errors_name_the_argument():
         ModelSpec.parse("lambert", ["beta=30"])
     with pytest.raises(BrdfkitError, match="--times 2 needs --pump"):
         ModelSpec.parse("modified-phong", times=2)
-    with pytest.raises(BrdfkitError, match="--times must be an integer from 1 to 8; got 9"):
+    with pytest.raises(BrdfkitError, match="--times must be an integer from 1 to 4; got 9"):
         ModelSpec.parse("modified-phong", pump="max", times=9)
     with pytest.raises(BrdfkitError, match="--pump must be one of max, controlled; got 'up'"):
         ModelSpec.parse("modified-phong", pump="up")
@@ -270,7 +270,7 @@ def test_dict_errors_name_the_key():
         ModelSpec.from_dict({"model": "lambert", "params": [1, 2]})
     with pytest.raises(ParameterError, match="pump must be 'max', 'controlled' or none; got 'up'"):
         ModelSpec.from_dict({"model": "lambert", "pump": "up"})
-    with pytest.raises(ParameterError, match="times must be an integer from 1 to 8; got 0"):
+    with pytest.raises(ParameterError, match="times must be an integer from 1 to 4; got 0"):
         ModelSpec.from_dict({"model": "lambert", "pump": {"g": "max", "times": 0}})
     with pytest.raises(ParameterError, match="pump: unknown argument 'k'; valid: g, times"):
         ModelSpec.from_dict({"model": "lambert", "pump": {"g": "max", "k": 2}})

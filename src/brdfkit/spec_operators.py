@@ -50,7 +50,7 @@ def _compensation():  # as _pumping: imported on first use
 
 #: Why the number of pumpings is bounded (:data:`MAX_TIMES`), for messages and help.
 TIMES_REASON = ("each pumping tabulates the previous stage's albedo, so the cost grows with "
-                "the number of stages: times=8 takes about a minute")
+                "the number of stages: times=4 takes 1-2.5 minutes on 2 cores")
 
 
 def times_problem(times) -> str | None:

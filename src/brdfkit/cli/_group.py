@@ -7,11 +7,14 @@
   value out of range, unknown command or option). ``--help`` and
   ``--version`` exit 0; ``brdfkit`` with no command prints the help (exit 2,
   as click does).
-- While a command runs, SIGTERM raises :class:`SystemExit` (status 143 =
-  128 + 15, the shell convention) so that ``finally``/``except
+- While a command runs, SIGTERM raises :class:`Stopped` (a :class:`SystemExit`,
+  status 143 = 128 + 15, the shell convention) so that ``finally``/``except
   BaseException`` blocks run — the atomic figure writer removes its temp
-  file — instead of the process dying on the spot. The previous handler is
-  restored afterwards (the group may run inside another program or a test).
+  file — instead of the process dying on the spot; Ctrl-C (KeyboardInterrupt)
+  becomes :class:`Stopped` with status 130 = 128 + 2. Either prints one line,
+  ``brdfkit: terminated`` or ``brdfkit: interrupted`` (no traceback, no click
+  "Aborted!"). The previous handler is restored afterwards (the group may run
+  inside another program or a test).
 - Commands may be registered lazily (``lazy={name: "module:attribute"}``): the
   module is imported when the command is looked up, so a command pays only
   for its own imports.
@@ -28,7 +31,8 @@ import click
 
 from brdfkit.errors import BrdfkitError
 
-__all__ = ["EXIT_USAGE", "EXIT_SIGTERM", "BrdfkitGroup", "OneLineError", "one_line"]
+__all__ = ["EXIT_USAGE", "EXIT_SIGTERM", "EXIT_INTERRUPT", "BrdfkitGroup", "OneLineError",
+           "Stopped", "one_line"]
 
 #: Exit status for bad input (the same as click's usage errors).
 EXIT_USAGE = 2
@@ -38,6 +42,26 @@ _NO_ARGS_IS_HELP = getattr(click.exceptions, "NoArgsIsHelpError", ())
 
 #: Exit status after SIGTERM: 128 + signal number, as a shell reports a killed process.
 EXIT_SIGTERM = 128 + int(signal.SIGTERM)
+#: Exit status after Ctrl-C (SIGINT), by the same convention.
+EXIT_INTERRUPT = 128 + int(signal.SIGINT)
+
+
+class Stopped(SystemExit):
+    """The command was stopped by a signal (SIGTERM or Ctrl-C): exits with *status* after
+    one line ``brdfkit: WORD[: detail]`` on stderr. A SystemExit, so ``except Exception``
+    does not swallow it and ``finally`` blocks run."""
+
+    def __init__(self, status: int, word: str, detail: str = ""):
+        super().__init__(status)
+        self.word, self.detail = word, detail
+
+    @classmethod
+    def interrupted(cls, detail: str = "") -> Stopped:
+        """Ctrl-C: status :data:`EXIT_INTERRUPT` (130), ``brdfkit: interrupted``."""
+        return cls(EXIT_INTERRUPT, "interrupted", detail)
+
+    def line(self) -> str:
+        return f"brdfkit: {self.word}" + (f": {one_line(self.detail)}" if self.detail else "")
 
 
 def one_line(message: str) -> str:
@@ -64,12 +88,13 @@ def _usage_message(exc: click.UsageError) -> str:
 
 
 def _raise_sigterm(signum, frame):  # noqa: ARG001  (signal handler signature)
-    raise SystemExit(EXIT_SIGTERM)
+    raise Stopped(EXIT_SIGTERM, "terminated")
 
 
 @contextlib.contextmanager
 def _sigterm_raises_systemexit():
-    """Within the block, SIGTERM raises SystemExit(143); the old handler is restored after."""
+    """Within the block, SIGTERM raises Stopped (SystemExit 143); the old handler is restored
+    after."""
     if threading.current_thread() is not threading.main_thread():
         yield  # signal handlers can only be set from the main thread
         return
@@ -112,6 +137,8 @@ class BrdfkitGroup(click.Group):
             raise  # bare 'brdfkit': the help is the useful answer
         except click.UsageError as exc:
             raise OneLineError(_usage_message(exc)) from exc
+        except KeyboardInterrupt:
+            raise Stopped.interrupted() from None
 
     def invoke(self, ctx: click.Context):
         try:
@@ -124,7 +151,13 @@ class BrdfkitGroup(click.Group):
             raise OneLineError(exc.format_message()) from exc
         except BrdfkitError as exc:
             raise OneLineError(str(exc)) from exc
+        except KeyboardInterrupt:  # before click's main turns it into "Aborted!"
+            raise Stopped.interrupted() from None
 
     def main(self, *args, **kwargs):
         with _sigterm_raises_systemexit():
-            return super().main(*args, **kwargs)
+            try:
+                return super().main(*args, **kwargs)
+            except Stopped as exc:
+                click.echo(exc.line(), err=True)
+                raise SystemExit(exc.code) from None

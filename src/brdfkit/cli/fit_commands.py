@@ -20,7 +20,7 @@ import numpy as np
 
 import brdfkit.cli._progress as _progress
 from brdfkit.cli._common import COMPENSATE_HELP, PARAM_HELP, emit_json
-from brdfkit.cli._group import OneLineError, one_line
+from brdfkit.cli._group import OneLineError, Stopped, one_line
 from brdfkit.errors import BrdfkitError
 from brdfkit.fitting import LOSSES, PROCEDURES  # the registries' names (--loss, --procedure)
 from brdfkit.fitting.batch import CONNECT_TIMEOUT_S
@@ -51,7 +51,8 @@ __all__ = ["fit_cmd"]
               default="l1", show_default=True, help="The loss minimised (docs/fitting.md).")
 @click.option("--procedure", type=click.Choice(list(PROCEDURES)),
               default="auto", show_default=True, help="The fitting procedure.")
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of random starts.")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Seed of the random starts, an integer >= 0.")
 @click.option("--starts", type=click.IntRange(min=1), default=3, show_default=True,
               help="Runs of the shape stage (first guess, defaults, random).")
 @click.option("--theta-max", "theta_max", type=click.FloatRange(0.0, 90.0, min_open=True),
@@ -163,7 +164,7 @@ def _albedo_line(r) -> str:
 def _batch(models, targets, *, param, start, pump, times, loss, procedure, seed, theta_max, as_json,
            plot, out, workers, scheduler) -> None:
     """``brdfkit fit MODEL... --to SPEC... --out FILE.csv``: one row per fit."""
-    from brdfkit.fitting.batch import Job, fit_row, run_batch
+    from brdfkit.fitting.batch import BatchInterrupted, Job, fit_row, run_batch
 
     if out is None:
         raise BrdfkitError(f"{len(models)} model(s) x {len(targets)} material(s) is a batch: "
@@ -189,9 +190,12 @@ def _batch(models, targets, *, param, start, pump, times, loss, procedure, seed,
     jobs = [Job(m, t, loss=loss, procedure=procedure, options=options)
             for m in models for t in targets]
     show = _progress.stderr_is_interactive()
-    with _progress.counter("fit", enabled=show) as progress:
-        report = run_batch(jobs, out=out, run_job=fit_row, workers=workers,
-                           scheduler=scheduler, progress=progress, notice=_note)
+    try:
+        with _progress.counter("fit", enabled=show) as progress:
+            report = run_batch(jobs, out=out, run_job=fit_row, workers=workers,
+                               scheduler=scheduler, progress=progress, notice=_note)
+    except BatchInterrupted as exc:  # Ctrl-C: one 'brdfkit: interrupted: ...' line, status 130
+        raise Stopped.interrupted(str(exc).removeprefix("interrupted: ")) from None
     nc = f"{report.not_converged} not converged, " if report.not_converged else ""
     click.echo(f"{report.out}: {report.done} fitted now, {report.skipped} already there, "
                f"{nc}{report.failed} failed, of {report.total} ({report.seconds:.1f} s)")

@@ -139,12 +139,20 @@ def read_binary(path) -> MerlTable:
     Raises
     ------
     DataFileError
-        Naming the file and what was expected vs found: not a file, header not
+        Naming the file and what was expected vs found: no such file, a symbolic
+        link loop or a dangling link (the OS's reason), not a file, header not
         (90, 90, 180), truncated or too long, NaN/inf entries, every entry invalid.
     """
     p = os.fspath(path)
-    if not os.path.exists(p):
-        raise DataFileError(f"{p}: no such file")
+    try:
+        os.stat(p)
+    except FileNotFoundError:
+        if os.path.islink(p):
+            raise DataFileError(f"{p}: a symbolic link to a missing file "
+                                f"({os.readlink(p)})") from None
+        raise DataFileError(f"{p}: no such file") from None
+    except OSError as err:  # e.g. a symbolic link loop, a permission denied on the path
+        raise DataFileError(f"{p}: cannot be read ({err.strerror})") from None
     if not os.path.isfile(p):
         raise DataFileError(f"{p}: not a regular file")
     size = os.path.getsize(p)

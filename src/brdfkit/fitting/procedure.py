@@ -133,6 +133,7 @@ import numpy as np
 
 from brdfkit._threads import numba_threads
 from brdfkit.errors import ParameterError
+from brdfkit.fitting._checks import check_channels, check_fit_args, check_samples
 from brdfkit.fitting._result import FitResult
 from brdfkit.fitting._run import (  # noqa: F401 - the procedure's constants, documented here
     BOUND_LOSS_RTOL,
@@ -274,7 +275,11 @@ def fit(model: BRDF, target: BRDF, *, loss: str = "l1", procedure: str = "auto",
     Raises
     ------
     ParameterError
-        Unknown loss or procedure, bad fixed values, n_starts < 1, non-model inputs.
+        Unknown loss or procedure, bad fixed values, n_starts < 1, non-model inputs; seed
+        not an integer >= 0, max_evals not an integer >= 1, progress not callable, fixed
+        not a dict, strides not two integers >= 1, theta_max outside (0, pi/2] or leaving
+        no sample pair, a coloured model whose channel count is neither 1 nor the
+        target's.
     """
     if not isinstance(model, BRDF):
         raise ParameterError(f"fit: model must be a brdfkit model; got {type(model).__name__}")
@@ -284,12 +289,17 @@ def fit(model: BRDF, target: BRDF, *, loss: str = "l1", procedure: str = "auto",
                              f"{type(target).__name__}")
     objective = get_loss(loss)  # the errors list the names
     proc = get_procedure(procedure)
-    if not (isinstance(n_starts, int | np.integer) and n_starts >= 1):
+    if not (isinstance(n_starts, int | np.integer) and not isinstance(n_starts, bool)
+            and n_starts >= 1):
         raise ParameterError(f"fit: n_starts must be an integer >= 1; got {n_starts!r}")
-    fixed = dict(fixed or {})
+    fixed, theta_max, strides = check_fit_args(fixed=fixed, theta_max=theta_max, seed=seed,
+                                               strides=strides, max_evals=max_evals,
+                                               progress=progress)
     if fixed:
         model = model.with_params(**fixed)  # validates names and values
         fixed = {k: model.values[k] for k in fixed}
+    check_channels(model, target)
+    check_samples(strides=strides, theta_max=theta_max)
     with numba_threads(1):  # see the module docstring
         settings = Settings(loss=objective, procedure=proc, theta_max=theta_max, seed=seed,
                             n_starts=n_starts, strides=strides, max_evals=max_evals)

@@ -25,7 +25,14 @@ import numpy as np
 
 from brdfkit.errors import ParameterError
 
-__all__ = ["Lobe", "Param"]
+__all__ = ["Lobe", "MAX_CHANNELS", "Param"]
+
+#: Most values of a per-channel (``colour``) or per-lobe (``lobes``) parameter. A
+#: spectrum sampled every nanometre over the visible range (360-830 nm) has 471 values;
+#: 1024 leaves room for that. Every image, table and kernel row grows with the channel
+#: count: a 256x256 sphere render costs ~48 bytes per pixel and channel (measured, PNG
+#: output), so 20000 channels asked for > 4 GB where 1024 take 3.2 GB at most.
+MAX_CHANNELS = 1024
 
 
 @dataclass(frozen=True)
@@ -114,6 +121,10 @@ class Param:
         invalid."""
         if value is None and self.optional:
             return None
+        if value is None:
+            raise ParameterError(
+                f"{model}: parameter {self.name!r} must be {self._expected()}; got None "
+                "(only optional parameters take None)")
         if self.kind == "bool":
             return self._flag(value, model)
         if type(value) is float and self.kind != "choice" and self._inside(value):
@@ -126,6 +137,10 @@ class Param:
             return value.lower()
         try:
             arr = np.asarray(value, dtype=np.float64)
+        except OverflowError:  # an int beyond float64 (e.g. 10**400)
+            raise ParameterError(
+                f"{model}: parameter {self.name!r} must lie in {self.bounds_text()}; got a "
+                f"number too large for a float ({_short(value)})") from None
         except (TypeError, ValueError):
             raise ParameterError(
                 f"{model}: parameter {self.name!r} must be a number in {self.bounds_text()}; "
@@ -138,6 +153,11 @@ class Param:
             )
         if arr.ndim == 1 and arr.size == 0:
             raise ParameterError(f"{model}: parameter {self.name!r} is an empty sequence")
+        if arr.ndim == 1 and arr.size > MAX_CHANNELS:
+            what = "channels" if self.kind == "colour" else "lobes"
+            raise ParameterError(
+                f"{model}: parameter {self.name!r} takes at most MAX_CHANNELS = {MAX_CHANNELS} "
+                f"values ({what}; memory grows with them); got {arr.size}")
         for x in np.atleast_1d(arr):
             if not self._inside(float(x)):
                 raise ParameterError(
@@ -145,6 +165,13 @@ class Param:
                     f"{' ' + self.unit if self.unit else ''}; got {_fmt(float(x))}"
                 )
         return float(arr) if arr.ndim == 0 else arr.copy()
+
+    def _expected(self) -> str:
+        if self.kind == "choice":
+            return self.bounds_text()
+        if self.kind == "bool":
+            return "true or false"
+        return f"a number in {self.bounds_text()}"
 
     def _flag(self, value, model: str) -> bool:
         if isinstance(value, bool | np.bool_):
@@ -180,6 +207,12 @@ class Param:
 
 #: The words a bool parameter accepts (any case), and what they mean.
 _FLAG_WORDS = {"true": True, "false": False, "1": True, "0": False}
+
+
+def _short(value) -> str:
+    """*value* as text, at most 40 characters (a 400-digit integer is not printed whole)."""
+    text = str(value)
+    return text if len(text) <= 40 else f"{text[:12]}...({len(text)} characters)"
 
 
 def _fmt(x: float) -> str:

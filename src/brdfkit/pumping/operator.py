@@ -63,12 +63,16 @@ G_FLOOR = 1e-12
 
 #: Most pumpings of one model (``times`` plus the stages it already has). Each stage
 #: tabulates the albedo of the stage below it with the albedo engine, whose integrand
-#: runs every stage below and has more kinks with every stage, so the cost grows faster
-#: than the number of stages (8 controlled pumpings of the n = 20 Phong take about a
-#: minute on 2 cores, 16 did not finish in 9); and more has no visible effect: after 5
-#: pumpings of that Phong ρ_hh is 0.999 (``docs/pumping.md``). The CLI's ``--times``
-#: has the same bound.
-MAX_TIMES = 8
+#: runs every stage below and has more kinks with every stage, so the cost grows much
+#: faster than the number of stages. Measured (2 cores, ``brdfkit eval modified-phong
+#: --pump controlled --times K``, default parameters, building the stages): K = 1, 2:
+#: under 1 s each; K = 3: 6 s; K = 4: 36 s (2.5 min on a loaded machine); K = 5: 155 s.
+#: (``--pump max`` of the same model stays one lookup per pair, a few seconds up to
+#: K = 6, but the bound is one for every g and every model.) More has little visible
+#: effect anyway: the gains of rho_hh of the n = 20 Phong after 1-4 controlled pumpings
+#: are 0.234, 0.072, 0.017, 0.005 (``docs/pumping.md``). The CLI's ``--times`` and the
+#: explorer have the same bound.
+MAX_TIMES = 4
 
 
 class PumpingWarning(UserWarning):
@@ -538,8 +542,10 @@ def _check_times(fn: str, model: BRDF, times) -> None:
         raise ParameterError(
             f"{fn}: times must be at most MAX_TIMES = {MAX_TIMES} pumpings in all{already}; "
             f"got times = {int(times)}. Each stage tabulates the previous stage's albedo with "
-            "the albedo engine, so the cost grows with the stages, and more has no visible "
-            "effect (after 5 pumpings of the n = 20 Phong rho_hh = 0.999)")
+            "the albedo engine, so the cost grows much faster than the stages (4 controlled "
+            "pumpings of modified-phong take 1-2.5 min on 2 cores, 5 about 3), and more "
+            "has little visible effect (the 4th pumping of the n = 20 Phong adds 0.005 to "
+            "rho_hh)")
 
 
 def pump_sequence(model: BRDF, g: str | Callable = "max", *, times: int = 3) -> list[BRDF]:

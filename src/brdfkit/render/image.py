@@ -165,9 +165,27 @@ def write_npy(path, radiance, *, option: str = "path") -> str:
     return _io.write_atomic(path, lambda fh: np.save(fh, rad), option=option)
 
 
+#: Largest value an EXR FLOAT channel (IEEE 32-bit) holds; larger radiance would be
+#: written as inf.
+EXR_MAX = float(np.finfo(np.float32).max)
+
+
 def write_exr(path, radiance, *, option: str = "path") -> str:
-    """Save *radiance* as an uncompressed FLOAT OpenEXR file, atomically."""
+    """Save *radiance* as an uncompressed FLOAT OpenEXR file, atomically.
+
+    Raises
+    ------
+    BrdfkitError
+        A value is not finite or beyond :data:`EXR_MAX` (it would be written as inf).
+    """
     _io.check_output_path(path, option=option, suffixes=(".exr",))
+    values = np.asarray(radiance, dtype=np.float64)
+    peak = float(np.max(np.abs(values))) if values.size else 0.0
+    if not peak <= EXR_MAX:  # also NaN/inf
+        raise BrdfkitError(
+            f"{option} {path}: the radiance reaches {peak:.6g}, beyond the largest value of "
+            f"an EXR 32-bit float channel ({EXR_MAX:.6g}; it would be written as inf); lower "
+            "the light (irradiance/ambient) or write .npy (float64)")
     data = exr_bytes(radiance)
     return _io.write_atomic(path, lambda fh: fh.write(data), option=option)
 

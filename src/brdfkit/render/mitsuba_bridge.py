@@ -110,7 +110,71 @@ from brdfkit.render.mitsuba_wavefront import wavefront, wavefront_class
 from brdfkit.spec import model as build_model
 
 __all__ = ["FALLBACK", "ROUTES", "VARIANTS", "mitsuba_bsdf", "spectral_model", "use_variant",
-           "wavefront"]
+           "wavefront", "MAX_LANES", "MAX_SAMPLES", "MITSUBA_MAX_SIZE", "SEED_LIMIT",
+           "check_seed", "check_samples", "render_bounded"]
+
+#: Most paths (pixels x samples per pixel) of one ``mi.render`` call when the image has
+#: fewer pixels; a render with more is split into calls of fewer samples per pixel
+#: (:func:`render_bounded`). Mitsuba traces every path of a call at once: measured ~600
+#: bytes per path for the wavefront route (lambert, 16² px x 65536 spp in 8 passes of
+#: 2^21 paths: 1.4 GB), so 2^20 paths keep a call near 0.6 GB.
+MAX_LANES = 2**20
+#: Most samples (pixels x samples per pixel) of one render. Measured on 2 cores: the
+#: wavefront route traces ~0.26 M samples/s (lambert, 512² x 64 spp: 65 s), the traced
+#: route (microfacet) ~3 M/s, so 2^30 samples take ~70 min and ~6 min; beyond, a render
+#: runs for hours or days (4096² x 65536 spp: ~130 years of the wavefront route).
+MAX_SAMPLES = 2**30
+#: Largest image side of a Mitsuba render: one sample per pixel of a 2048² image is 4.2 M
+#: paths in one call (~2.5 GB at the measured 600 bytes per path; a whole render of 2048²,
+#: 8 spp in 8 passes peaked at 3.0 GB, measured); 4096² would take 10 GB.
+MITSUBA_MAX_SIZE = 2048
+#: Mitsuba's seeds are 32-bit unsigned integers: 0 <= seed < SEED_LIMIT.
+SEED_LIMIT = 2**32
+#: Seed step between the calls of a split render (the golden-ratio constant of 32-bit
+#: hashing: the calls' seeds stay distinct and far from seed + small k of other passes).
+_SEED_STEP = 0x9E3779B9
+
+
+def check_seed(seed, name: str = "seed") -> int:
+    """*seed* as an int in [0, :data:`SEED_LIMIT`); :class:`ParameterError` naming *name*."""
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) \
+            or not 0 <= seed < SEED_LIMIT:
+        raise ParameterError(f"{name} must be an integer from 0 to {SEED_LIMIT - 1} "
+                             f"(Mitsuba's seeds are 32-bit); got {seed!r}")
+    return int(seed)
+
+
+def check_samples(pixels: int, spp: int, *, size_name: str = "size") -> None:
+    """*pixels* x *spp* at most :data:`MAX_SAMPLES`; the error states the cost."""
+    if int(pixels) * int(spp) > MAX_SAMPLES:
+        raise ParameterError(
+            f"{size_name} and spp: {int(pixels)} pixels x {int(spp)} samples per pixel = "
+            f"{int(pixels) * int(spp):.3g} samples; at most MAX_SAMPLES = 2^30 = "
+            f"{MAX_SAMPLES:.3g} per render (~70 min at the measured 0.26 M samples/s of the "
+            f"wavefront route on 2 cores); lower spp to {max(1, MAX_SAMPLES // int(pixels))} "
+            f"or fewer, or the size")
+
+
+def render_bounded(scene, *, spp: int, seed: int, pixels: int) -> np.ndarray:
+    """``mi.render(scene, spp, seed)`` as float64, in calls of at most
+    max(:data:`MAX_LANES`, *pixels*) paths: a render of more is split into calls of
+    fewer samples per pixel (seeds seed, seed + step, … mod 2^32) and their images
+    combined as the sample-weighted mean (what one call would estimate). A render that
+    fits in one call is exactly ``mi.render(scene, spp=spp, seed=seed)``."""
+    mi, _ = _mitsuba()
+    spp, seed, pixels = int(spp), int(seed), max(1, int(pixels))
+    per_call = max(1, MAX_LANES // pixels)
+    if spp <= per_call:
+        return np.array(mi.render(scene, spp=spp, seed=seed), dtype=np.float64)
+    total, done, call = None, 0, 0
+    while done < spp:
+        n = min(per_call, spp - done)
+        image = np.array(mi.render(scene, spp=n, seed=(seed + call * _SEED_STEP) % SEED_LIMIT),
+                         dtype=np.float64)
+        total = n * image if total is None else total + n * image
+        done += n
+        call += 1
+    return total / spp
 
 #: variant → the traced BSDF class (one per variant)
 _TRACED = bounded_cache("brdfkit.render.mitsuba_bridge._TRACED", maxsize=len(VARIANTS))

@@ -52,9 +52,13 @@ import numpy as np
 from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
 from brdfkit.render.mitsuba_bridge import (
+    MITSUBA_MAX_SIZE,
     _mitsuba,
+    check_samples,
+    check_seed,
     irradiance_spectrum,
     mitsuba_bsdf,
+    render_bounded,
     use_variant,
     wavefront,
 )
@@ -129,11 +133,15 @@ def render_sphere_mitsuba(model: BRDF, *, phi_l: float = 0.0, ambient: float = 0
     irradiance : float
         E ≥ 0 of the directional light (on a surface facing it).
     size : int
-        S, the image is S×S pixels (1 … 4096).
+        S, the image is S×S pixels (1 … :data:`~brdfkit.render.mitsuba_bridge.MITSUBA_MAX_SIZE`
+        = 2048).
     spp : int
-        Samples per pixel (1 … 65536); the noise falls as 1/√spp.
+        Samples per pixel (1 … 65536, and S² × spp at most
+        :data:`~brdfkit.render.mitsuba_bridge.MAX_SAMPLES` = 2^30); the noise falls as
+        1/√spp. Memory is bounded: a render of more than 2^20 paths is split into calls
+        (:func:`~brdfkit.render.mitsuba_bridge.render_bounded`).
     seed : int
-        Mitsuba's sampler seed (the render is deterministic given it).
+        Mitsuba's sampler seed, 0 … 2^32 − 1 (the render is deterministic given it).
     variant : str
         ``llvm_ad_rgb`` (default), ``llvm_ad_mono``, ``llvm_ad_spectral`` or a
         ``scalar_*`` one (slow); an unavailable ``llvm_*`` variant falls back
@@ -185,16 +193,24 @@ def render_sphere_mitsuba_passes(model: BRDF, *, phi_l: float = 0.0, ambient: fl
     k = int(k)
     counts = [int(spp) // k + (1 if j < int(spp) % k else 0) for j in range(k)]
     jobs = [(n, (k * int(seed) + j) % 2**32) for j, n in enumerate(counts)]  # Mitsuba: uint32
-    images = _render(model, jobs, phi_l=phi_l, ambient=ambient, irradiance=irradiance,
-                     size=size, variant=variant, wavelengths=wavelengths,
-                     illuminant=illuminant)
+    images = _render_each(model, jobs, phi_l=phi_l, ambient=ambient, irradiance=irradiance,
+                          size=size, variant=variant, wavelengths=wavelengths,
+                          illuminant=illuminant)
     if k == 1:
-        return images[0], None, 1
-    n = np.asarray(counts, dtype=np.float64).reshape(k, 1, 1, 1)
-    stack = np.stack(images)
-    mean = np.sum(n * stack, axis=0) / n.sum()
-    s2 = np.sum(n * (stack - mean) ** 2, axis=0) / (k - 1)
-    return mean, np.sqrt(s2 / n.sum()), k
+        return next(images), None, 1
+    # the sample-weighted mean and sum of squares, one pass image at a time (West 1979's
+    # weighted update), so that memory holds a few images, not K of them: S = sum n_k
+    # (x_k - mean)^2 after the last pass, s^2 = S / (K - 1) (module docstring)
+    mean, ss, total = None, None, 0.0
+    for n_k, image in zip(counts, images, strict=True):
+        total += n_k
+        if mean is None:
+            mean, ss = image, np.zeros_like(image)
+            continue
+        delta = image - mean
+        mean += (n_k / total) * delta
+        ss += n_k * delta * (image - mean)
+    return mean, np.sqrt(ss / (k - 1) / total), k
 
 
 def _check_args(model, *, phi_l, ambient, irradiance, size, spp, seed) -> None:
@@ -206,16 +222,25 @@ def _check_args(model, *, phi_l, ambient, irradiance, size, spp, seed) -> None:
         if not (isinstance(value, (int, float)) and lo <= value <= hi and math.isfinite(value)):
             raise ParameterError(f"{name} must be a finite number in [{lo:g}, {hi:g}]; "
                                  f"got {value!r}")
-    for name, value, lo, hi in (("size", size, 1, 4096), ("spp", spp, 1, 65536)):
+    for name, value, lo, hi in (("size", size, 1, MITSUBA_MAX_SIZE), ("spp", spp, 1, 65536)):
         if not (isinstance(value, (int, np.integer)) and lo <= value <= hi):
             raise ParameterError(f"{name} must be an integer in [{lo}, {hi}]; got {value!r}")
-    if not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ParameterError(f"seed must be a non-negative integer; got {seed!r}")
+    check_seed(seed)
+    check_samples(int(size) ** 2, spp)
 
 
 def _render(model, jobs, *, phi_l, ambient, irradiance, size, variant, wavelengths,
             illuminant) -> list[np.ndarray]:
     """One scene, rendered once per (spp, seed) of *jobs*: images (S, S, C) float64."""
+    return list(_render_each(model, jobs, phi_l=phi_l, ambient=ambient, irradiance=irradiance,
+                             size=size, variant=variant, wavelengths=wavelengths,
+                             illuminant=illuminant))
+
+
+def _render_each(model, jobs, *, phi_l, ambient, irradiance, size, variant, wavelengths,
+                 illuminant):
+    """As :func:`_render`, one image at a time (a generator: only the image being used is
+    held)."""
     mi, _ = _mitsuba()
     used = use_variant(variant)
     bsdf = mitsuba_bsdf(model, wavelengths=wavelengths)
@@ -223,9 +248,7 @@ def _render(model, jobs, *, phi_l, ambient, irradiance, size, variant, wavelengt
                                       ambient=ambient, size=size, variant=used,
                                       illuminant=illuminant))
     # the traced route renders in Dr.Jit's default symbolic mode, the other one per wavefront
-    images = []
-    with contextlib.nullcontext() if bsdf.traced else wavefront():
-        for spp, seed in jobs:
-            out = np.array(mi.render(scene, spp=int(spp), seed=int(seed)), dtype=np.float64)
-            images.append(out[:, :, None] if out.ndim == 2 else out)
-    return images
+    for spp, seed in jobs:
+        with contextlib.nullcontext() if bsdf.traced else wavefront():
+            out = render_bounded(scene, spp=spp, seed=seed, pixels=int(size) ** 2)
+        yield out[:, :, None] if out.ndim == 2 else out

@@ -12,13 +12,16 @@ correct, and ~10⁴× slower (small images only).
 Public objects
 --------------
 - :data:`FALLBACK`, :data:`VARIANTS` — the supported variants and each one's fallback.
-- :func:`import_mitsuba` — ``(mitsuba, drjit)``, or an error saying how to install them.
+- :func:`import_mitsuba` — ``(mitsuba, drjit)``, or an error saying how to install them;
+  Mitsuba's log (its WARN/ERROR lines) is routed to stderr, so that it never mixes
+  with a command's output on stdout.
 - :func:`select_variant` — set a variant, or its fallback with a warning.
   (:func:`brdfkit.render.mitsuba_bridge.use_variant` also registers the plugin.)
 """
 
 from __future__ import annotations
 
+import sys
 import warnings
 
 from brdfkit.errors import BrdfkitError, ParameterError
@@ -41,7 +44,32 @@ def import_mitsuba():
         raise BrdfkitError(
             f"rendering through Mitsuba needs the packages mitsuba and drjit ({exc}); "
             "install them with: pip install mitsuba") from None
+    if not _LOG:
+        _route_log(mi)
     return mi, dr
+
+
+#: The appender routing Mitsuba's log to stderr (kept alive here; empty until the first
+#: import of Mitsuba).
+_LOG: list = []
+
+
+def _route_log(mi) -> None:
+    """Replace Mitsuba's log appenders (a StreamAppender on stdout) by one on stderr, plain
+    text; progress bars are dropped (brdfkit shows its own)."""
+
+    class StderrAppender(mi.Appender):
+        def append(self, level, text):  # noqa: ARG002 (Mitsuba's signature)
+            print(text, file=sys.stderr, flush=True)
+
+        def log_progress(self, *args, **kwargs):
+            pass
+
+    logger = mi.logger() if hasattr(mi, "logger") else mi.Thread.thread().logger()
+    appender = StderrAppender()
+    logger.clear_appenders()
+    logger.add_appender(appender)
+    _LOG.append(appender)
 
 
 def select_variant(variant: str, *, stacklevel: int = 1) -> str:

@@ -66,13 +66,23 @@ from brdfkit.render.silhouette import (
 from brdfkit.status import STATUS
 
 __all__ = ["SphereRender", "render_sphere", "sphere_geometry", "exposure_phi0", "MAX_SIZE",
-           "ENGINES"]
+           "ENGINES", "MAX_RENDER_VALUES", "BYTES_PER_VALUE"]
 
 #: Largest image side: 8192² pixels of 3 channels are 1.6 GB of float64 radiance.
 MAX_SIZE = 8192
 #: Largest θ_V the ambient table is built to for the rim's sub-samples (89.9°: the last
 #: 0.1° of the rim is under 2e-6 of the radius wide, far below a pixel at any size).
 RIM_THETA_MAX = math.radians(89.9)
+#: Peak memory of a direct render and its output file per pixel and channel, measured
+#: (maximum resident size of ``brdfkit render sphere`` at 2048², RGB, less that at 16²):
+#: 48 bytes with a PNG (the float64 image, its exposed copy, the 8-bit rows), 34 with
+#: an EXR and the ambient term, 11 for a plain .npy.
+BYTES_PER_VALUE = 48
+#: Most pixels x channels of a direct render: a memory budget of 12 GiB (half of the
+#: 24 GiB machine this was measured on) at :data:`BYTES_PER_VALUE`, so ~268 M values; an
+#: RGB image of :data:`MAX_SIZE`² (201 M values, ~9.7 GB) fits. 20000 channels at 256²
+#: (1.3 G values) asked for > 4 GB before the bound and are refused.
+MAX_RENDER_VALUES = (12 * 2**30) // BYTES_PER_VALUE
 #: Engines of :func:`render_sphere`; ``mitsuba`` (Monte Carlo) is planned (issue 11 §3).
 ENGINES = ("direct", "mitsuba")
 #: Default samples per pixel of the Monte-Carlo engine.
@@ -413,6 +423,12 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
     E = _check_number(irradiance, "irradiance")
     S = _check_size(size)
     C = model.n_channels or 1
+    if engine == "direct" and S * S * C > MAX_RENDER_VALUES:
+        raise ParameterError(
+            f"size {S} with {C} channels is {S * S * C:.3g} pixel values; a render holds at "
+            f"most MAX_RENDER_VALUES = {MAX_RENDER_VALUES:.3g} (~{BYTES_PER_VALUE} bytes each "
+            f"at peak, a 12 GiB budget): use a size of at most "
+            f"{math.isqrt(MAX_RENDER_VALUES // C)} or fewer channels")
     if engine == "mitsuba":
         from brdfkit.render.mitsuba_sphere import render_sphere_mitsuba_passes
 

@@ -57,7 +57,15 @@ import numpy as np
 from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
 from brdfkit.render.metals import METALS, WAVELENGTHS, metal_nk, metal_phong
-from brdfkit.render.mitsuba_bridge import _mitsuba, mitsuba_bsdf, use_variant, wavefront
+from brdfkit.render.mitsuba_bridge import (
+    _mitsuba,
+    check_samples,
+    check_seed,
+    mitsuba_bsdf,
+    render_bounded,
+    use_variant,
+    wavefront,
+)
 
 __all__ = ["render_tank", "tank_scene", "check_render_options", "TANK_HALF", "WALL_HEIGHT",
            "WALL_THICKNESS", "PYRAMIDS", "POINT_LIGHTS", "SKY_RADIANCE", "CAMERA", "MAX_DEPTH",
@@ -179,13 +187,15 @@ def tank_scene(bsdfs: dict, *, width: int, height: int, max_depth: int = MAX_DEP
 
 def check_render_options(*, size, spp, seed, max_depth=MAX_DEPTH) -> None:
     """Raise :class:`ParameterError` naming the first of *size* (16 … 2048), *spp*
-    (1 … 4096), *seed* (≥ 0), *max_depth* (2 … 64) that is not an allowed integer."""
+    (1 … 4096), *seed* (0 … 2^32 − 1, Mitsuba's), *max_depth* (2 … 64) that is not an
+    allowed integer, or when size × height × spp exceeds
+    :data:`~brdfkit.render.mitsuba_bridge.MAX_SAMPLES` (2^30 samples per render)."""
     for name, value, lo, hi in (("size", size, 16, 2048), ("spp", spp, 1, 4096),
                                 ("max_depth", max_depth, 2, 64)):
         if not (isinstance(value, (int, np.integer)) and lo <= value <= hi):
             raise ParameterError(f"{name} must be an integer in [{lo}, {hi}]; got {value!r}")
-    if not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ParameterError(f"seed must be a non-negative integer; got {seed!r}")
+    check_seed(seed)
+    check_samples(int(size) * max(1, round(ASPECT * int(size))), spp)
 
 
 def render_tank(phong: BRDF, *, size: int = 320, spp: int = 16, seed: int = 0,
@@ -233,7 +243,7 @@ def render_tank(phong: BRDF, *, size: int = 320, spp: int = 16, seed: int = 0,
         scene = mi.load_dict(tank_scene(bsdfs, width=width, height=height,
                                         max_depth=max_depth))
         with wavefront():
-            image = np.array(mi.render(scene, spp=int(spp), seed=int(seed)), dtype=np.float64)
+            image = render_bounded(scene, spp=spp, seed=seed, pixels=width * height)
         keep = idx[: min(PACK, lam.size - start)]
         out[:, :, keep] = image[:, :, : keep.size]
         del scene, bsdfs
