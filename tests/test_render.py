@@ -232,6 +232,11 @@ def test_exr_npy_png_round_trips(tmp_path, rng):
         assert np.array_equal(np.asarray(im), to_srgb8(r.radiance, 2.0))
         meta = json.loads(im.info["brdfkit"])
     assert meta["exposure"] == 2.0 and meta["model"]["model"] == "lambert"
+    # the EXR carries the render's metadata too (issue 20: it had none), as a string attribute
+    typ, raw = _read_exr((tmp_path / "s.exr").read_bytes())[0]["brdfkit"]
+    exr_meta = json.loads(raw.decode())
+    assert typ == "string" and exr_meta["model"] == r.metadata()["model"]
+    assert exr_meta["phi_l_deg"] == pytest.approx(math.degrees(0.4))
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".brdfkit-")]
 
 
@@ -348,3 +353,14 @@ def test_terminator_pixels_are_those_the_line_n_dot_l_0_crosses():
     assert set(cols.tolist()) == {4} and sorted(rows.tolist()) == list(range(8))
     # L = +z (behind the viewer): N·L = N_z > 0 on the whole disc, no terminator
     assert terminator_pixels(8, (0.0, 0.0, 1.0)).size == 0
+
+
+def test_exr_metadata_is_read_by_openexr(tmp_path):
+    # a second reader: Mitsuba's Bitmap (the OpenEXR library) reads the string attribute
+    mi = pytest.importorskip("mitsuba")
+    mi.set_variant("scalar_rgb")
+    r = render_sphere(brdfkit.model("lambert", rho_d=0.3), phi_l=0.2, size=8)
+    save_render(r, tmp_path / "m.exr")
+    meta = json.loads(mi.Bitmap(str(tmp_path / "m.exr")).metadata()["brdfkit"])
+    assert meta["model"] == {"model": "lambert", "params": {"rho_d": 0.3}}
+    assert meta["size"] == 8 and meta["engine"] == "direct"

@@ -7,7 +7,8 @@ Writing renders: linear NPY and OpenEXR, sRGB PNG with a stated exposure
   channels (``R``, ``G``, ``B`` for 3 channels, ``Y`` for 1, ``C0`` … otherwise),
   linear radiance. Written here (no OpenEXR package is needed): magic and
   version, the eight required header attributes, the offset table and one
-  scanline per chunk, as the OpenEXR file layout specifies.
+  scanline per chunk, as the OpenEXR file layout specifies. The render's
+  metadata (as the PNG's) is a ``string`` attribute ``brdfkit`` (JSON).
 - ``.png`` — 8-bit sRGB (grey for 1 channel, RGB for 3): the displayed value
   is sRGB(min(1, k·L)) with the exposure k (see :func:`apply_exposure`), the
   IEC 61966-2-1 transfer function, rounded to the nearest of 0 … 255. The
@@ -103,8 +104,9 @@ def _attr(name: str, type_name: str, value: bytes) -> bytes:
             + value)
 
 
-def exr_bytes(radiance) -> bytes:
-    """An uncompressed scanline OpenEXR file of *radiance* (S_rows, S_cols, C), FLOAT."""
+def exr_bytes(radiance, metadata: str | None = None) -> bytes:
+    """An uncompressed scanline OpenEXR file of *radiance* (S_rows, S_cols, C), FLOAT; with
+    *metadata*, a ``string`` attribute ``brdfkit`` holding it (UTF-8)."""
     rad = _check_image(radiance)
     height, width, C = rad.shape
     names = exr_channel_names(C)
@@ -121,6 +123,7 @@ def exr_bytes(radiance) -> bytes:
               + _attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
               + _attr("screenWindowCenter", "v2f", struct.pack("<ff", 0.0, 0.0))
               + _attr("screenWindowWidth", "float", struct.pack("<f", 1.0))
+              + (b"" if metadata is None else _attr("brdfkit", "string", metadata.encode()))
               + b"\0")
     line_bytes = width * C * 4
     chunk = 8 + line_bytes  # y, data size, then the data
@@ -170,8 +173,9 @@ def write_npy(path, radiance, *, option: str = "path") -> str:
 EXR_MAX = float(np.finfo(np.float32).max)
 
 
-def write_exr(path, radiance, *, option: str = "path") -> str:
-    """Save *radiance* as an uncompressed FLOAT OpenEXR file, atomically.
+def write_exr(path, radiance, *, metadata: dict | None = None, option: str = "path") -> str:
+    """Save *radiance* as an uncompressed FLOAT OpenEXR file, atomically; *metadata*
+    (JSON-ready) goes into a ``string`` attribute ``brdfkit``.
 
     Raises
     ------
@@ -186,7 +190,8 @@ def write_exr(path, radiance, *, option: str = "path") -> str:
             f"{option} {path}: the radiance reaches {peak:.6g}, beyond the largest value of "
             f"an EXR 32-bit float channel ({EXR_MAX:.6g}; it would be written as inf); lower "
             "the light (irradiance/ambient) or write .npy (float64)")
-    data = exr_bytes(radiance)
+    text = None if metadata is None else json.dumps(metadata, sort_keys=True, default=str)
+    data = exr_bytes(radiance, text)
     return _io.write_atomic(path, lambda fh: fh.write(data), option=option)
 
 
@@ -217,7 +222,8 @@ def save_render(render, path, *, exposure: float | None = None, exposure_rule: s
         None: 1/peak of this image (its brightest pixel just unsaturated).
         Ignored for the linear formats.
     exposure_rule : str, keyword-only
-        How *exposure* was chosen, recorded in the PNG's metadata.
+        How *exposure* was chosen, recorded in the PNG's metadata (the EXR's records
+        the render's metadata without an exposure).
     option : str, keyword-only
         How the caller names *path* in errors (the CLI passes ``"--out"``).
     """
@@ -225,8 +231,8 @@ def save_render(render, path, *, exposure: float | None = None, exposure_rule: s
     suffix = p.lower().rsplit(".", 1)[-1]
     if suffix == "npy":
         return write_npy(p, render.radiance, option=option)
-    if suffix == "exr":
-        return write_exr(p, render.radiance, option=option)
+    if suffix == "exr":  # linear: no exposure, the render's own metadata
+        return write_exr(p, render.radiance, metadata=render.metadata(), option=option)
     if exposure is None:
         peak = render.peak
         if not peak > 0.0:
