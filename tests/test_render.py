@@ -358,9 +358,14 @@ def test_terminator_pixels_are_those_the_line_n_dot_l_0_crosses():
 def test_exr_metadata_is_read_by_openexr(tmp_path):
     # a second reader: Mitsuba's Bitmap (the OpenEXR library) reads the string attribute
     mi = pytest.importorskip("mitsuba")
-    mi.set_variant("scalar_rgb")
     r = render_sphere(brdfkit.model("lambert", rho_d=0.3), phi_l=0.2, size=8)
     save_render(r, tmp_path / "m.exr")
-    meta = json.loads(mi.Bitmap(str(tmp_path / "m.exr")).metadata()["brdfkit"])
+    old = mi.variant()  # restored after: other tests of this process keep theirs
+    mi.set_variant("scalar_rgb")
+    try:
+        meta = json.loads(mi.Bitmap(str(tmp_path / "m.exr")).metadata()["brdfkit"])
+    finally:
+        if old is not None:
+            mi.set_variant(old)
     assert meta["model"] == {"model": "lambert", "params": {"rho_d": 0.3}}
     assert meta["size"] == 8 and meta["engine"] == "direct"
