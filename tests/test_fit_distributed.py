@@ -292,8 +292,9 @@ def test_a_scheduler_without_workers_is_said_and_ctrl_c_stops(tmp_path):
         c.stop()
     assert note.startswith(f"brdfkit: note: the Dask scheduler {c.address} has no worker yet"), \
         note
-    assert code == 2 and stderr.strip().splitlines() == [
-        f"brdfkit: error: interrupted: 0 of 1 rows are in {out}; re-run the same command to "
+    # the one line and status of every interrupted command (130 = 128 + SIGINT)
+    assert code == 130 and stderr.strip().splitlines() == [
+        f"brdfkit: interrupted: 0 of 1 rows are in {out}; re-run the same command to "
         "resume"], stderr
 
 

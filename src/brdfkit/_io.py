@@ -24,6 +24,7 @@ from typing import BinaryIO
 
 import numpy as np
 
+from brdfkit._cache import memo
 from brdfkit.errors import BrdfkitError
 
 __all__ = ["write_atomic", "check_output_path", "to_jsonable", "remove_stale_temp_files",
@@ -36,7 +37,14 @@ _TEMP_NAME = re.compile(r"\.brdfkit-(?:(?P<pid>\d+)-)?[a-z0-9_]{8}(?:\.[A-Za-z0-
 #: A temporary file without a pid (written before the pid was in the name) is stale when
 #: it is older than this: no write of brdfkit takes an hour between creating and renaming.
 UNTAGGED_STALE_SECONDS = 3600.0
-_CLEANED: set[str] = set()  # directories this process has cleaned
+
+#: The directories whose stale temporary files this process has removed (once each): a
+#: bounded memo — a directory evicted after 256 others is only cleaned once more.
+@memo(maxsize=256)
+def _clean_once(directory: str) -> bool:
+    remove_stale_temp_files(directory)
+    return True
+
 
 
 def check_output_path(path, *, option: str = "path", suffixes: tuple[str, ...] = ()) -> str:
@@ -78,9 +86,7 @@ def write_atomic(path, write: Callable[[BinaryIO], None], *, option: str = "path
     """
     p = check_output_path(path, option=option)
     directory = os.path.dirname(os.path.abspath(p))
-    if directory not in _CLEANED:
-        _CLEANED.add(directory)
-        remove_stale_temp_files(directory)
+    _clean_once(directory)
     try:
         fd, tmp = tempfile.mkstemp(prefix=f"{TEMP_PREFIX}{os.getpid()}-",
                                    suffix=os.path.splitext(p)[1], dir=directory)

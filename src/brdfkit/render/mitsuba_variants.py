@@ -24,6 +24,7 @@ from __future__ import annotations
 import sys
 import warnings
 
+from brdfkit._cache import memo
 from brdfkit.errors import BrdfkitError, ParameterError
 
 __all__ = ["FALLBACK", "VARIANTS", "import_mitsuba", "select_variant"]
@@ -44,19 +45,15 @@ def import_mitsuba():
         raise BrdfkitError(
             f"rendering through Mitsuba needs the packages mitsuba and drjit ({exc}); "
             "install them with: pip install mitsuba") from None
-    if not _LOG:
-        _route_log(mi)
+    _route_log(mi)
     return mi, dr
 
 
-#: The appender routing Mitsuba's log to stderr (kept alive here; empty until the first
-#: import of Mitsuba).
-_LOG: list = []
-
-
-def _route_log(mi) -> None:
+#: Once per process; the memo also keeps a Python reference to the appender.
+@memo(maxsize=1)
+def _route_log(mi):
     """Replace Mitsuba's log appenders (a StreamAppender on stdout) by one on stderr, plain
-    text; progress bars are dropped (brdfkit shows its own)."""
+    text; progress bars are dropped (brdfkit shows its own). Returns the appender."""
 
     class StderrAppender(mi.Appender):
         def append(self, level, text):  # noqa: ARG002 (Mitsuba's signature)
@@ -69,7 +66,7 @@ def _route_log(mi) -> None:
     appender = StderrAppender()
     logger.clear_appenders()
     logger.add_appender(appender)
-    _LOG.append(appender)
+    return appender
 
 
 def select_variant(variant: str, *, stacklevel: int = 1) -> str:
