@@ -26,13 +26,18 @@ def free_port() -> int:
 
 @pytest.fixture(scope="module")
 def server():
+    import tempfile
+
     import uvicorn
 
     from brdfkit.explorer.app import create_app
+    from brdfkit.explorer.worker import SHUTDOWN_GRACE_S
 
     port = free_port()
-    srv = uvicorn.Server(uvicorn.Config(create_app(), host="127.0.0.1", port=port,
-                                        log_level="warning"))
+    # the tests' files are in the temporary directory: the user's --allow-dir
+    app = create_app(allow_dirs=[tempfile.gettempdir()])
+    srv = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning",
+                                        timeout_graceful_shutdown=SHUTDOWN_GRACE_S))
     thread = threading.Thread(target=srv.run, daemon=True)
     thread.start()
     for _ in range(200):

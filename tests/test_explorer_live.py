@@ -118,12 +118,13 @@ def test_watcher_sees_content_changes_not_touches(tmp_path, monkeypatch):
 
 # --------------------------------------------------------------------------- the API
 @pytest.fixture
-def client():
+def client(tmp_path):
     from fastapi.testclient import TestClient
 
     from brdfkit.explorer.app import create_app
 
-    return TestClient(create_app(), **LOCAL)
+    with TestClient(create_app(allow_dirs=[tmp_path]), **LOCAL) as c:
+        yield c
 
 
 def test_api_reloads_a_file_model_and_keeps_the_last_good(client, tmp_path):
@@ -169,7 +170,8 @@ def test_api_opens_a_file_by_path_from_this_machine_only(tmp_path, monkeypatch):
     from brdfkit.explorer.app import create_app
 
     app = create_app()
-    local, remote = TestClient(app, **LOCAL), TestClient(app)
+    local = TestClient(app, **LOCAL)
+    remote = TestClient(app, client=("10.1.2.3", 50000), headers=LOCAL["headers"])
     p = tmp_path / "lam.binary"
     _lambert_binary(p, 0.3)
     r = local.post("/api/open", json={"path": str(p)})
@@ -201,7 +203,7 @@ def test_a_python_file_runs_only_once_the_user_named_it(tmp_path):
     marker = tmp_path / "ran"
     py.write_text(f"open({str(marker)!r}, 'w').close()\n"
                   + LAMBERT_PY.format(scale=1.0, name="rho"))
-    c = TestClient(create_app(), **LOCAL)
+    c = TestClient(create_app(allow_dirs=[tmp_path]), **LOCAL)
     state = {"models": [{"spec": str(py)}]}
     m = c.post("/api/views", json=state).json()["models"][0]
     assert "a link cannot open it" in m["error"] and not marker.exists()
@@ -539,9 +541,11 @@ def _views(c, state):
 
 
 def _join_compiles(c):
-    for t in list(c.app.state.files.threads):
-        t.join(timeout=300)
-        assert not t.is_alive()
+    import asyncio
+
+    # the compiling threads are in the worker process: a job that joins them
+    asyncio.run(c.app.state.worker.run("join", {"timeout": 300.0},
+                                       deadline=time.monotonic() + 310.0, what="join"))
 
 
 def test_api_formula_edit_draft_then_compiled(tmp_path):
@@ -560,7 +564,7 @@ def test_api_formula_edit_draft_then_compiled(tmp_path):
     k = 1.0 + float(rng.random())
     p.write_text(LAMBERT_BRDF.replace("rho / 3.14", f"{k!r} * rho / 3.14"))
     py.write_text(LAMBERT_PY.format(scale=k, name="rho"))
-    c = TestClient(create_app(opened=[str(py)]), **LOCAL)
+    c = TestClient(create_app(opened=[str(py)], allow_dirs=[tmp_path]), **LOCAL)
     for f, rtol in ((p, 1e-6), (py, 1e-12)):
         state = {"models": [{"spec": str(f), "params": {"rho": 0.4}}]}
         first = _views(c, state)
