@@ -167,6 +167,8 @@ class _Job:
     def __init__(self, loop, conn):
         self.loop, self.conn = loop, conn
         self.future = loop.create_future()
+        # its error is read (or the request went away): no "exception never retrieved"
+        self.future.add_done_callback(lambda f: f.cancelled() or f.exception())
         self.parts: dict[int, object] = {}
 
     def settle(self, ok: bool, value) -> None:
@@ -286,6 +288,10 @@ class Worker:
             except TimeoutError:
                 raise OverBudget(f"{what}: over the time budget", dict(job.parts),
                                  started=True) from None
+            except asyncio.CancelledError:
+                # the server is stopping (Ctrl-C): the request ends with a message, not a
+                # cancelled task that the server would log with a traceback
+                raise RequestError("the explorer is stopping", 503) from None
             finished = True
             return result, dict(job.parts)
         finally:
