@@ -183,9 +183,19 @@ def create_app(*, opened=(), allow_dirs=(), host: str = "127.0.0.1",
     app.state.budget_s = budget_s
 
     def over(what: str) -> str:
-        return (f"not drawn: the {what} request ran over the explorer's time budget of "
+        return (f"not done: the {what} request ran over the explorer's time budget of "
                 f"{budget_s:g} s and was stopped (a pumped model with a large 'times' takes "
                 "longest: lower 'times', or start brdfkit explore with a larger --budget)")
+
+    async def run(kind: str, payload: dict, what: str):
+        """One whole job within the budget; over it, a 503 naming the budget."""
+        try:
+            return (await worker.run(kind, payload, deadline=time.monotonic() + budget_s,
+                                     what=what))[0]
+        except OverBudget as exc:
+            if not exc.started:
+                raise
+            raise OverBudget(f"{what}: " + over(what), {}, started=True) from None
 
     def checked(entries: list) -> tuple[list, dict]:
         """The entries a request may compute, and ``{index: error entry}`` of the others."""
@@ -293,10 +303,9 @@ def create_app(*, opened=(), allow_dirs=(), host: str = "127.0.0.1",
     @app.post("/api/export/binary")
     async def export_binary(request: Request):
         entry = await one_model(await _body(request), "export")
-        (name, data), _ = await worker.run(
-            "export", {"entry": entry, "given": sorted(access.given),
-                       "digests": await run_in_threadpool(digests, [(0, entry)])},
-            deadline=time.monotonic() + budget_s, what="export")
+        name, data = await run("export", {
+            "entry": entry, "given": sorted(access.given),
+            "digests": await run_in_threadpool(digests, [(0, entry)])}, "export")
         return Response(data, media_type="application/octet-stream",
                         headers={"Content-Disposition": f'attachment; filename="{name}"'})
 
@@ -317,8 +326,7 @@ def create_app(*, opened=(), allow_dirs=(), host: str = "127.0.0.1",
         target = await one_model({"spec": body["target"]}, "fit target")
         given = sorted(access.given)
         # built in the worker first (within the budget): a bad spec is a 400 here
-        names, _ = await worker.run("names", {"entries": [model, target], "given": given},
-                                    deadline=time.monotonic() + budget_s, what="fit")
+        names = await run("names", {"entries": [model, target], "given": given}, "fit")
         return {"id": fits.start(model=model, target=target, loss=loss, given=given,
                                  names=names)}
 
