@@ -83,12 +83,26 @@ def _call(base, path, body=None, *, headers=None, raw=None, timeout=120.0):
 def server(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("explore")
     proc, base = _start(tmp)
-    # warm: the worker's first model (cold start ~5 s) is not what the tests measure
-    status, got, _ = _call(base, "/api/views", {"models": [{"spec": "lambert"}]})
-    assert status == 200 and "polar" in got["models"][0], got
-    yield base, tmp / "allowed", tmp
-    proc.terminate()
-    proc.wait(timeout=30)
+    try:
+        # warm: the worker's first model (cold start ~5 s, more on a loaded machine) is not
+        # what the tests measure
+        assert _drawn(base), "the server never drew a Lambertian model"
+        yield base, tmp / "allowed", tmp
+    finally:
+        proc.terminate()
+        proc.wait(timeout=30)
+
+
+def _drawn(base, rho: float = 0.5, tries: int = 10) -> bool:
+    """The server draws Lambert's f_r = ρ/π (closed form) within *tries* requests (a fresh
+    worker warms up first: on a loaded machine a request may run out of the budget)."""
+    for _ in range(tries):
+        status, got, _ = _call(base, "/api/views", {"models": [{"spec": "lambert",
+                                                                "params": {"rho_d": rho}}]})
+        m = got["models"][0] if status == 200 else {}
+        if "polar" in m:
+            return abs(m["polar"]["values"][0][90] - rho / math.pi) < 1e-12
+    return False
 
 
 def _children(pid: int) -> set[int]:
@@ -131,10 +145,10 @@ def test_heavy_request_stops_at_its_budget_and_the_server_keeps_answering(server
     print(f"heavy request answered in {dt:.2f} s; other requests meanwhile: max "
           f"{max(waits):.3f} s over {len(waits)}")
     assert len(waits) >= 6 and max(waits) < 2.0, waits
-    status, got, _ = _call(base, "/api/views", {"models": [{"spec": "lambert",
-                                                            "params": {"rho_d": 0.5}}]})
-    assert status == 200
-    assert abs(got["models"][0]["polar"]["values"][0][90] - 0.5 / math.pi) < 1e-12
+    # the same model again (the page's verdict request follows its views): answered at once
+    status, got, dt = _call(base, "/api/verdict", {"models": [HEAVY]})
+    assert status == 200 and dt < 1.0 and "time budget" in got["verdicts"][0]["error"], dt
+    assert _drawn(base, 0.25)  # the worker was restarted: the server draws again
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
@@ -159,7 +173,7 @@ def test_ctrl_c_and_sigterm_stop_the_server_mid_computation(tmp_path, sig):
             proc.kill()
     print(f"{signal.Signals(sig).name}: stopped in {took:.2f} s")
     assert took <= 3.0, took
-    assert "Traceback" not in err, err
+    assert "Traceback" not in err and "ERROR" not in err, err
     time.sleep(0.5)
     assert not [k for k in kids if os.path.exists(f"/proc/{k}")
                 and open(f"/proc/{k}/stat").read().split()[2] != "Z"], kids

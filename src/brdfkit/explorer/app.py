@@ -56,6 +56,7 @@ drives directly (Panel/Bokeh render in shadow DOM). Panel itself was not
 benchmarked here.
 """
 
+import json
 import math
 import time
 from contextlib import asynccontextmanager
@@ -65,6 +66,7 @@ from fastapi import FastAPI, Request
 from fastapi.responses import HTMLResponse, JSONResponse, Response
 from starlette.concurrency import run_in_threadpool
 
+from brdfkit._cache import bounded_cache
 from brdfkit.data import material_names
 from brdfkit.data.catalog import MATERIAL_SOURCES
 from brdfkit.errors import BrdfkitError
@@ -75,6 +77,12 @@ from brdfkit.models import MODELS
 from brdfkit.spec import MAX_TIMES
 
 __all__ = ["create_app", "build_entry", "entry_spec", "parse_state"]
+
+#: Bytes of an oversized body read (and discarded) before answering 413: a client sending
+#: a little too much gets the message rather than a broken pipe; beyond this, the reply.
+_DRAIN_BYTES = 64 * guard.MAX_BODY_BYTES
+#: Models remembered as over the budget (a page shows 8; a few pages, a few edits).
+_COSTLY_SIZE = 64
 
 
 def _number(state: dict, key: str, default: float, lo: float, hi: float) -> float:
@@ -118,17 +126,18 @@ def _from_this_machine(request: Request) -> bool:
 
 
 async def _body(request: Request):
-    """The request's JSON body (at most MAX_BODY_BYTES, read in chunks), or a
-    RequestError saying what was wrong with it."""
-    n = request.headers.get("content-length", "")
-    if n.isdigit() and int(n) > guard.MAX_BODY_BYTES:
-        return guard.read_json(b" " * (guard.MAX_BODY_BYTES + 1))  # the 413 message
+    """The request's JSON body (at most MAX_BODY_BYTES kept, read in chunks), or a
+    RequestError saying what was wrong with it. A larger body is read to its end (up to
+    _DRAIN_BYTES, discarded) so that the client receives the 413 instead of a broken pipe."""
     chunks, size = [], 0
     async for chunk in request.stream():
         size += len(chunk)
-        if size > guard.MAX_BODY_BYTES:
-            return guard.read_json(b" " * size)
-        chunks.append(chunk)
+        if size <= guard.MAX_BODY_BYTES:
+            chunks.append(chunk)
+        elif size > _DRAIN_BYTES:
+            break
+    if size > guard.MAX_BODY_BYTES:
+        raise guard.too_large(size)
     return guard.read_json(b"".join(chunks))
 
 
@@ -166,6 +175,10 @@ def create_app(*, opened=(), allow_dirs=(), host: str = "127.0.0.1",
                               dirs=allow_dirs)
     watcher = files.FileWatcher()
     worker = Worker(on_mark=watcher.mark)
+    # models that ran over the budget on a warm worker (LRU): the same model in the next
+    # request (the page's verdict, a light move) is answered at once instead of stopping
+    # the worker once more; another 'times' or parameter is another model
+    too_costly = bounded_cache(None, maxsize=_COSTLY_SIZE)
     fits = Fits()
 
     @asynccontextmanager
@@ -182,10 +195,9 @@ def create_app(*, opened=(), allow_dirs=(), host: str = "127.0.0.1",
     app.state.worker, app.state.access, app.state.watcher = worker, access, watcher
     app.state.budget_s = budget_s
 
-    def over(what: str) -> str:
-        return (f"not done: the {what} request ran over the explorer's time budget of "
-                f"{budget_s:g} s and was stopped (a pumped model with a large 'times' takes "
-                "longest: lower 'times', or start brdfkit explore with a larger --budget)")
+    over = (f"not done: over the explorer's time budget of {budget_s:g} s per request, "
+            "stopped (a pumped model with a large 'times' takes longest: lower 'times', "
+            "or start brdfkit explore with a larger --budget)")
 
     async def run(kind: str, payload: dict, what: str):
         """One whole job within the budget; over it, a 503 naming the budget."""
@@ -195,7 +207,7 @@ def create_app(*, opened=(), allow_dirs=(), host: str = "127.0.0.1",
         except OverBudget as exc:
             if not exc.started:
                 raise
-            raise OverBudget(f"{what}: " + over(what), {}, started=True) from None
+            raise OverBudget(f"{what}: {over}", {}, started=True) from None
 
     def checked(entries: list) -> tuple[list, dict]:
         """The entries a request may compute, and ``{index: error entry}`` of the others."""
@@ -218,17 +230,32 @@ def create_app(*, opened=(), allow_dirs=(), host: str = "127.0.0.1",
                 out[path] = watcher.digest(path)
         return out
 
+    def costly_key(entry: dict, found: dict) -> str:
+        path = files.spec_file(entry["spec"])
+        return json.dumps([entry.get(k) for k in ("spec", "params", "pump", "times",
+                                                  "compensate")] + [found.get(path)])
+
     async def per_model(kind: str, s: dict) -> tuple[list, int]:
         ok, out = checked(s["models"])
         version = watcher.version
+        found = await run_in_threadpool(digests, ok)
+        for i, e in ok:  # known to exceed the budget: answered at once (reason: too_costly)
+            if costly_key(e, found) in too_costly:
+                out[i] = error_entry(e, f"{e['spec'][:200]}: {over}")
+        ok = [(i, e) for i, e in ok if i not in out]
+        if not ok:
+            return [out[i] for i in range(len(s["models"]))], version
         payload = {"entries": [e for _, e in ok], "state": s, "given": sorted(access.given),
-                   "digests": await run_in_threadpool(digests, ok)}
+                   "digests": found}
         deadline = time.monotonic() + budget_s
         try:
             _, parts = await worker.run(kind, payload, deadline=deadline, what=kind)
-            message = over(kind)
+            message = over
         except OverBudget as exc:
-            parts, message = exc.parts, over(kind) if exc.started else str(exc)
+            parts, message = exc.parts, over if exc.started else str(exc)
+            slow = next((k for k in range(len(ok)) if k not in exc.parts), None)
+            if exc.warm and slow is not None:  # the model computing at the deadline
+                too_costly[costly_key(ok[slow][1], found)] = True
         for k, (i, e) in enumerate(ok):
             out[i] = parts[k] if k in parts else error_entry(e, f"{e['spec'][:200]}: {message}")
         return [out[i] for i in range(len(s["models"]))], version

@@ -41,7 +41,7 @@ from brdfkit.explorer import files
 
 __all__ = ["MAX_BODY_BYTES", "MAX_MODELS", "MAX_VALUES", "MAX_PARAMS", "MAX_SPEC_CHARS",
            "MAX_CHANNELS", "LOOPBACK", "RequestError", "served_names", "refusal", "read_json",
-           "check_entry", "check_beta", "FileAccess"]
+           "check_entry", "check_beta", "too_large", "FileAccess"]
 
 #: A request body: the largest valid state is MAX_MODELS entries of MAX_PARAMS parameters
 #: of MAX_VALUES numbers of ~24 characters each (8 × 64 × 64 × 24 B ≈ 786 KB, far beyond a
@@ -118,11 +118,16 @@ def refusal(*, method: str, host: str, origin: str | None, content_type: str | N
     return None
 
 
+def too_large(size: int) -> RequestError:
+    """The error of a request body of *size* bytes, over :data:`MAX_BODY_BYTES`."""
+    return RequestError(f"the request body is {size} bytes or more; the explorer takes at most "
+                        f"{MAX_BODY_BYTES} (MAX_BODY_BYTES)", 413)
+
+
 def read_json(body: bytes):
     """The request's JSON (at most :data:`MAX_BODY_BYTES`), or a RequestError."""
     if len(body) > MAX_BODY_BYTES:
-        raise RequestError(f"the request body is {len(body)} bytes; the explorer takes at most "
-                           f"{MAX_BODY_BYTES} (MAX_BODY_BYTES)", 413)
+        raise too_large(len(body))
     try:
         return json.loads(body)
     except RecursionError:

@@ -18,6 +18,7 @@ under ``allow_dirs`` (:mod:`brdfkit.explorer.guard`); each request computes for 
 from __future__ import annotations
 
 import json
+import logging
 import threading
 import urllib.parse
 import webbrowser
@@ -86,6 +87,10 @@ def serve(*, specs=(), host: str = LOCALHOST, port: int = DEFAULT_PORT, open_bro
     # worker is killed): Ctrl-C stops the server at once even mid-computation
     config = uvicorn.Config(app, host=host, port=port, log_level="warning",
                             timeout_graceful_shutdown=SHUTDOWN_GRACE_S)
+    # the requests cancelled at shutdown are ours to cancel (their worker is killed): not an
+    # error for the user
+    logging.getLogger("uvicorn.error").addFilter(
+        lambda r: "timeout graceful shutdown exceeded" not in r.getMessage())
     server = uvicorn.Server(config)
     if open_browser:
         threading.Timer(1.0, lambda: webbrowser.open(url)).start()

@@ -60,11 +60,12 @@ _PROGRESS_HZ = 10.0
 
 class OverBudget(BrdfkitError):
     """A request that ran out of its time budget: *parts* holds what was done; *started*:
-    whether its job ran (else the worker was busy with others all along)."""
+    whether its job ran (else the worker was busy with others all along); *warm*: the
+    worker had finished warming up when the job started (so the job itself was slow)."""
 
-    def __init__(self, message: str, parts: dict, *, started: bool):
+    def __init__(self, message: str, parts: dict, *, started: bool, warm: bool = False):
         super().__init__(message)
-        self.parts, self.started = parts, started
+        self.parts, self.started, self.warm = parts, started, warm
 
 
 def _start_child(kind: str):
@@ -116,6 +117,7 @@ def _worker_main(conn) -> None:
 
     session = Session(mark=lambda path: send(("mark", path)))
     _warm_up()
+    send(("ready",))
     while True:
         try:
             job_id, kind, payload = conn.recv()
@@ -195,6 +197,7 @@ class Worker:
         self._jobs: dict[int, _Job] = {}
         self._ids = itertools.count(1)
         self._stopped = False
+        self._ready = None  # the connection of the worker that has warmed up
         self.restarts = 0
 
     @property
@@ -220,6 +223,9 @@ class Worker:
             if msg[0] == "mark":
                 if self._on_mark is not None:
                     self._on_mark(msg[1])
+                continue
+            if msg[0] == "ready":
+                self._ready = conn
                 continue
             job = self._jobs.get(msg[1])
             if job is None:
@@ -281,13 +287,14 @@ class Worker:
             if conn is None:
                 raise BrdfkitError("the explorer is shutting down")
             job = self._jobs[job_id] = _Job(asyncio.get_running_loop(), conn)
+            warm = self._ready is conn
             conn.send((job_id, kind, payload))
             remaining = deadline - time.monotonic()
             try:
                 result = await asyncio.wait_for(asyncio.shield(job.future), max(remaining, 0))
             except TimeoutError:
                 raise OverBudget(f"{what}: over the time budget", dict(job.parts),
-                                 started=True) from None
+                                 started=True, warm=warm) from None
             except asyncio.CancelledError:
                 # the server is stopping (Ctrl-C): the request ends with a message, not a
                 # cancelled task that the server would log with a traceback
