@@ -59,6 +59,7 @@ benchmarked here.
 import json
 import math
 import time
+import weakref
 from contextlib import asynccontextmanager
 from importlib import resources
 
@@ -193,6 +194,10 @@ def create_app(*, opened=(), allow_dirs=(), host: str = "127.0.0.1",
     app.add_middleware(_Guard, names=guard.served_names(host))
     static = resources.files("brdfkit.explorer") / "static"
     app.state.worker, app.state.access, app.state.watcher = worker, access, watcher
+    # an app dropped without its lifespan's end (a test client used without `with`): its
+    # processes end with it
+    weakref.finalize(app, worker.stop)
+    weakref.finalize(app, fits.stop)
     app.state.budget_s = budget_s
 
     over = (f"not done: over the explorer's time budget of {budget_s:g} s per request, "
