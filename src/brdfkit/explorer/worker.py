@@ -54,6 +54,8 @@ FIT_BUDGET_S = 600.0
 MAX_FIT_RECORDS = 64
 #: Seconds the server waits for running requests on Ctrl-C/SIGTERM before cancelling them.
 SHUTDOWN_GRACE_S = 1.0
+#: Seconds between looks at a busy worker by a waiting request (cheap: a lock test).
+_SLOT_POLL_S = 0.01
 #: Progress messages a fit sends per second at most (the page polls every 0.5 s).
 _PROGRESS_HZ = 10.0
 
@@ -274,7 +276,9 @@ class Worker:
                     raise OverBudget(f"{what}: not started within the time budget: the "
                                      "explorer was busy with other requests", {},
                                      started=False)
-                await asyncio.sleep(0.01)
+                await asyncio.sleep(_SLOT_POLL_S)
+        except asyncio.CancelledError:  # the server is stopping: a message, no traceback
+            raise RequestError("the explorer is stopping", 503) from None
         finally:
             self._waiting -= 1
         job_id = next(self._ids)
@@ -288,7 +292,11 @@ class Worker:
                 raise BrdfkitError("the explorer is shutting down")
             job = self._jobs[job_id] = _Job(asyncio.get_running_loop(), conn)
             warm = self._ready is conn
-            conn.send((job_id, kind, payload))
+            try:
+                conn.send((job_id, kind, payload))
+            except OSError:  # the process died between jobs (killed from outside, OOM)
+                raise RequestError("the explorer's worker process stopped; it is being "
+                                   "restarted: try again", 503) from None
             remaining = deadline - time.monotonic()
             try:
                 result = await asyncio.wait_for(asyncio.shield(job.future), max(remaining, 0))
