@@ -254,7 +254,8 @@ def create_app(*, opened=(), allow_dirs=(), host: str = "127.0.0.1",
                    "digests": found}
         deadline = time.monotonic() + budget_s
         try:
-            _, parts = await worker.run(kind, payload, deadline=deadline, what=kind)
+            _, parts = await worker.run(kind, payload, deadline=deadline, what=kind,
+                                        low=kind == "verdicts")
             message = over
         except OverBudget as exc:
             parts, message = exc.parts, over if exc.started else str(exc)

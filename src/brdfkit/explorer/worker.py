@@ -194,6 +194,7 @@ class Worker:
         self._lock = threading.Lock()  # the process handle
         self._slot = threading.Lock()  # one job at a time
         self._waiting = 0
+        self._urgent = 0  # waiting jobs that are not low priority
         self._proc = None
         self._conn = None
         self._jobs: dict[int, _Job] = {}
@@ -262,16 +263,20 @@ class Worker:
         self._stopped = True
         self._kill()
 
-    async def run(self, kind: str, payload: dict, *, deadline: float, what: str):
+    async def run(self, kind: str, payload: dict, *, deadline: float, what: str,
+                  low: bool = False):
         """Run one job before *deadline* (``time.monotonic()``); its result. Raises
         :class:`OverBudget` (with the parts done) when the deadline passes, a BrdfkitError
-        with the job's error otherwise. *what* names the request in the messages."""
+        with the job's error otherwise. *what* names the request in the messages; a *low*
+        priority job (a verdict) lets every waiting other job (the views of a slider move)
+        go first."""
         if self._waiting >= MAX_WAITING:
             raise OverBudget(f"{what}: the explorer is busy ({MAX_WAITING} requests waiting, "
                              "MAX_WAITING); try again in a moment", {}, started=False)
         self._waiting += 1
+        self._urgent += 0 if low else 1
         try:
-            while not self._slot.acquire(blocking=False):
+            while (low and self._urgent) or not self._slot.acquire(blocking=False):
                 if time.monotonic() >= deadline:
                     raise OverBudget(f"{what}: not started within the time budget: the "
                                      "explorer was busy with other requests", {},
@@ -281,6 +286,7 @@ class Worker:
             raise RequestError("the explorer is stopping", 503) from None
         finally:
             self._waiting -= 1
+            self._urgent -= 0 if low else 1
         job_id = next(self._ids)
         job = None
         finished = False
