@@ -37,7 +37,8 @@ or typed into the page's "open file" box, whose request must come from this mach
 (client address, ``Host`` and ``Origin`` all loopback: another web site open in the
 browser cannot post one, a DNS-rebound name is refused). A ``.py`` spec arriving any
 other way (a shared link's state) is refused with a message saying to open it first.
-Data files (``.binary``, ``.brdf``) run no code and load from a link as before.
+Data files (``.binary``, ``.brdf``) run no code; a link may name one the user gave or one
+under ``--allow-dir`` (:class:`brdfkit.explorer.guard.FileAccess`).
 
 Public objects
 --------------
