@@ -136,6 +136,10 @@ class MerlTable:
         return cls(v / SCALES[:, None, None, None], source)
 
 
+def _dims_like(dims) -> bool:
+    return all(0 < int(x) <= _MAX_SHOWN_DIM for x in dims)
+
+
 def read_binary(path) -> MerlTable:
     """Read a MERL ``.binary`` file (layout in the module docstring).
 
@@ -160,9 +164,14 @@ def read_binary(path) -> MerlTable:
             if tuple(int(x) for x in dims) != SHAPE:
                 # dimensions a table could have are shown; other bytes are not echoed (the
                 # explorer reports this message for a path from a request: no file content)
-                found = (f"({', '.join(str(int(x)) for x in dims)})"
-                         if all(0 < int(x) <= _MAX_SHOWN_DIM for x in dims)
-                         else "bytes that are not table dimensions")
+                swapped = dims.byteswap()
+                if _dims_like(dims):
+                    found = f"({', '.join(str(int(x)) for x in dims)})"
+                elif _dims_like(swapped):
+                    found = (f"({', '.join(str(int(x)) for x in swapped)}) read big-endian "
+                             "(MERL files are little-endian)")
+                else:
+                    found = "bytes that are not table dimensions"
                 raise DataFileError(
                     f"{p}: header: expected dimensions (90, 90, 180); found {found} — not a "
                     "MERL isotropic .binary")
