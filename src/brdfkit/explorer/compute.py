@@ -159,14 +159,11 @@ class Session:
             return error_entry(entry, str(exc))
 
     def model_verdict(self, entry: dict, s: dict) -> dict:
-        """The plausibility verdict of one entry, cached per model (and, for an anisotropic
-        model, per φ_i): a direction move asks it again."""
+        """The plausibility verdict of one entry (a direction move asks it again: the
+        albedo engine's cache answers it in milliseconds)."""
         try:
-            m, info = self.get_built(entry)
-            phi = 0.0 if m.isotropic else s["phi_i"]
-            key = (self._key(entry) + "|" + info.get("digest", "") + "|verdict|"
-                   + ("" if info.get("compiled", True) else "interpreted") + f"|{phi!r}")
-            return self._cached(key, lambda: to_jsonable(views.verdict(m, phi=phi)))
+            m, _ = self.get_built(entry)
+            return to_jsonable(views.verdict(m, phi=s["phi_i"]))
         except BrdfkitError as exc:
             return {"spec": entry.get("spec") if isinstance(entry, dict) else None,
                     "error": str(exc)}
