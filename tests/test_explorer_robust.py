@@ -151,6 +151,40 @@ def test_heavy_request_stops_at_its_budget_and_the_server_keeps_answering(server
     assert _drawn(base, 0.25)  # the worker was restarted: the server draws again
 
 
+def test_a_views_request_goes_before_a_waiting_verdict():
+    """The worker computes one job at a time; the page asks a verdict after each views
+    answer, so a slider move's views must not wait behind a queued verdict. With the
+    worker busy (its one job slot held), a verdict-priority job queued first and a views
+    one second: the views job runs first. (Without the priority the two poll the slot
+    alike and either may win.)"""
+    import asyncio
+
+    from brdfkit.explorer.worker import Worker
+
+    async def scenario() -> list[str]:
+        w = Worker()
+        w.start()
+        order: list[str] = []
+
+        async def go(name: str, low: bool) -> None:
+            await w.run("names", {"entries": [{"spec": "lambert"}]},
+                        deadline=time.monotonic() + 120.0, what=name, low=low)
+            order.append(name)
+        try:
+            w._slot.acquire()  # the worker busy with another request
+            verdict = asyncio.create_task(go("verdict", True))
+            await asyncio.sleep(0.1)
+            views = asyncio.create_task(go("views", False))
+            await asyncio.sleep(0.1)
+            w._slot.release()
+            await asyncio.gather(verdict, views)
+        finally:
+            w.stop()
+        return order
+
+    assert asyncio.run(scenario()) == ["views", "verdict"]
+
+
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 def test_ctrl_c_and_sigterm_stop_the_server_mid_computation(tmp_path, sig):
     """Before: while busy the server ignored SIGINT and SIGTERM (SIGKILL only). Now it
