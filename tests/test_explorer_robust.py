@@ -362,3 +362,21 @@ def test_fuzz_random_json_never_500_and_within_budget(server):
             assert _call(base, p)[0] in (200, 404)
 
     check()
+
+
+def test_one_fit_at_a_time_in_a_process_of_its_own(server):
+    """Before: every POST /api/fit started a thread in the server (each a core for up to
+    minutes, on the server's GIL). Now a fit runs in a process of its own, one at a time:
+    a second is refused with one line naming the limit; the server answers meanwhile.
+    (Last in this module: the server's shutdown stops the fit.)"""
+    from brdfkit.explorer.worker import MAX_FITS
+
+    base, _, _ = server
+    body = {"model": {"spec": "lambert"}, "target": "merl:nickel", "loss": "l1"}
+    status, got, _ = _call(base, "/api/fit", body)
+    assert status == 200, got
+    status, second, _ = _call(base, "/api/fit", body)
+    assert status == 400 and f"{MAX_FITS} fit is running already" in second["error"], second
+    status, job, _ = _call(base, f"/api/fit/{got['id']}")
+    assert status == 200 and job["state"] in ("running", "done"), job
+    assert _call(base, "/api/catalog", timeout=5)[0] == 200
