@@ -271,8 +271,9 @@ def test_api_python_file_reload(tmp_path):
 
 # --------------------------------------------------------------------------- the browser
 def _url(base, specs):
-    models = [{"spec": s, "params": {}, "pump": None, "times": 1, "visible": True} for s in specs]
-    return base + "#" + urllib.parse.quote(json.dumps({"models": models}))
+    """The short address the command prints (serve.start_url: ``#m=SPEC,SPEC``); the page
+    expands it to its full state (so these browser tests check the expansion too)."""
+    return base + "#m=" + ",".join(urllib.parse.quote(s, safe="") for s in specs)
 
 
 def _wait_verdict(page):
@@ -452,8 +453,13 @@ def test_explore_command_serves_file_specs(tmp_path):
     try:
         line = proc.stderr.readline()
         url = line.split("serving on ", 1)[1].split(" ", 1)[0]
-        state = json.loads(urllib.parse.unquote(url.split("#", 1)[1]))
-        assert [m["spec"] for m in state["models"]] == ["a.binary", str(b)]
+        # the short form (issue 20: a ~700-character state was printed before)
+        short = url.split("#", 1)[1]
+        assert short.startswith("m=") and len(url) < 60 + len(str(b)) * 2, url
+        specs = [urllib.parse.unquote(s) for s in short[2:].split(",")]
+        assert specs == ["a.binary", str(b)]
+        state = {"models": [{"spec": s, "params": {}, "pump": None, "times": 1,
+                             "visible": True} for s in specs]}
         base = f"http://127.0.0.1:{port}"
         for _ in range(100):
             try:

@@ -17,7 +17,6 @@ under ``allow_dirs`` (:mod:`brdfkit.explorer.guard`); each request computes for 
 
 from __future__ import annotations
 
-import json
 import logging
 import threading
 import urllib.parse
@@ -32,12 +31,12 @@ LOCALHOST = "127.0.0.1"
 
 
 def start_url(host: str, port: int, specs=()) -> str:
-    """The page's address, with *specs* as the initial models in the URL state."""
+    """The page's address, with *specs* as the initial models in the short URL state
+    ``#m=SPEC,SPEC`` (each spec percent-encoded, a comma too), which the page expands to
+    its full state (the models at their defaults)."""
     url = f"http://{host}:{port}/"
     if specs:
-        state = {"models": [{"spec": s, "params": {}, "pump": None, "times": 1, "visible": True}
-                            for s in specs]}
-        url += "#" + urllib.parse.quote(json.dumps(state))
+        url += "#m=" + ",".join(urllib.parse.quote(str(s), safe="") for s in specs)
     return url
 
 
