@@ -71,7 +71,7 @@ def main() -> None:
         from fastapi.testclient import TestClient
 
         from brdfkit.explorer.app import create_app
-    client = TestClient(create_app())
+    client = TestClient(create_app(), base_url="http://127.0.0.1:8765")
     print(f"{'model':16s} {'param move':>10s} {'angle move':>10s}  | polar  curves  lobe  "
           "sphere  halfdiff  albedo  (ms, median of", n, ")")
     for spec, params, moved, value in MODELS:

@@ -16,6 +16,10 @@ import time
 import pytest
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+#: The time budget of the page tests' server (seconds per request): the page's behaviour is
+#: tested here, the budget in test_explorer_robust.py; a formula's compile holds the
+#: worker's GIL for 2-5 s, several times that on a loaded 2-core CI machine.
+TEST_BUDGET_S = 300.0
 
 
 def free_port() -> int:
@@ -26,13 +30,19 @@ def free_port() -> int:
 
 @pytest.fixture(scope="module")
 def server():
+    import tempfile
+
     import uvicorn
 
     from brdfkit.explorer.app import create_app
+    from brdfkit.explorer.worker import SHUTDOWN_GRACE_S
 
     port = free_port()
-    srv = uvicorn.Server(uvicorn.Config(create_app(), host="127.0.0.1", port=port,
-                                        log_level="warning"))
+    # the tests' files are in the temporary directory: the user's --allow-dir; the budget is
+    # tested in test_explorer_robust.py, here a compile on a loaded CI machine may take long
+    app = create_app(allow_dirs=[tempfile.gettempdir()], budget_s=TEST_BUDGET_S)
+    srv = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning",
+                                        timeout_graceful_shutdown=SHUTDOWN_GRACE_S))
     thread = threading.Thread(target=srv.run, daemon=True)
     thread.start()
     for _ in range(200):

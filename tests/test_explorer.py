@@ -68,7 +68,8 @@ def client():
 
     from brdfkit.explorer.app import create_app
 
-    return TestClient(create_app())
+    with TestClient(create_app(), base_url="http://127.0.0.1:8765") as c:
+        yield c
 
 
 def test_api_views_and_errors(client):
@@ -84,7 +85,8 @@ def test_api_views_and_errors(client):
     assert "n" in ms[2]["error"] and "-3" in ms[2]["error"]
     r = client.post("/api/views", json={"models": [], "theta_i": 95})
     assert r.status_code == 400 and "theta_i must lie in [0, 89.5]" in r.json()["error"]
-    r = client.post("/api/views", content=b"not json", headers={"content-type": "text/plain"})
+    r = client.post("/api/views", content=b"not json",
+                    headers={"content-type": "application/json"})
     assert r.status_code == 400 and "must be JSON" in r.json()["error"]
     cat = client.get("/api/catalog").json()
     assert {m["name"] for m in cat["models"]} == set(brdfkit.MODELS)

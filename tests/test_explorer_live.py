@@ -23,12 +23,13 @@ import json
 import math
 import os
 import re
+import threading
 import time
 import urllib.parse
 
 import numpy as np
 import pytest
-from explorer_harness import free_port, open_page
+from explorer_harness import TEST_BUDGET_S, free_port, open_page
 
 import brdfkit
 from brdfkit.data.export import export_merl
@@ -118,12 +119,13 @@ def test_watcher_sees_content_changes_not_touches(tmp_path, monkeypatch):
 
 # --------------------------------------------------------------------------- the API
 @pytest.fixture
-def client():
+def client(tmp_path):
     from fastapi.testclient import TestClient
 
     from brdfkit.explorer.app import create_app
 
-    return TestClient(create_app(), **LOCAL)
+    with TestClient(create_app(allow_dirs=[tmp_path], budget_s=TEST_BUDGET_S), **LOCAL) as c:
+        yield c
 
 
 def test_api_reloads_a_file_model_and_keeps_the_last_good(client, tmp_path):
@@ -169,7 +171,8 @@ def test_api_opens_a_file_by_path_from_this_machine_only(tmp_path, monkeypatch):
     from brdfkit.explorer.app import create_app
 
     app = create_app()
-    local, remote = TestClient(app, **LOCAL), TestClient(app)
+    local = TestClient(app, **LOCAL)
+    remote = TestClient(app, client=("10.1.2.3", 50000), headers=LOCAL["headers"])
     p = tmp_path / "lam.binary"
     _lambert_binary(p, 0.3)
     r = local.post("/api/open", json={"path": str(p)})
@@ -201,7 +204,7 @@ def test_a_python_file_runs_only_once_the_user_named_it(tmp_path):
     marker = tmp_path / "ran"
     py.write_text(f"open({str(marker)!r}, 'w').close()\n"
                   + LAMBERT_PY.format(scale=1.0, name="rho"))
-    c = TestClient(create_app(), **LOCAL)
+    c = TestClient(create_app(allow_dirs=[tmp_path], budget_s=TEST_BUDGET_S), **LOCAL)
     state = {"models": [{"spec": str(py)}]}
     m = c.post("/api/views", json=state).json()["models"][0]
     assert "a link cannot open it" in m["error"] and not marker.exists()
@@ -232,7 +235,7 @@ def test_api_brdf_file_reload_keeps_values_and_shows_line_col(client, tmp_path):
     # a broken edit (a syntax error): file:line:col, the last good version drawn
     p.write_text(LAMBERT_BRDF.replace("return vec3(", "return vec3(("))
     m = client.post("/api/views", json=state).json()["models"][0]
-    assert re.search(re.escape(str(p)) + r":\d+:\d+", m["reload_error"]), m["reload_error"]
+    assert re.search(re.escape(str(p)) + r":\d+:\d+", m.get("reload_error") or ""), m
     np.testing.assert_allclose(_slice0(m), 0.5 / math.pi, rtol=1e-6)
     # a rename: rho dropped (named), the new parameter at its default
     p.write_text(LAMBERT_BRDF.replace("rho", "kd").replace("0 1 0.5", "0 1 0.7"))
@@ -249,7 +252,7 @@ def test_api_python_file_reload(tmp_path):
 
     py = tmp_path / "lam.py"
     py.write_text(LAMBERT_PY.format(scale=1.0, name="rho"))
-    c = TestClient(create_app(opened=[str(py)]), **LOCAL)
+    c = TestClient(create_app(opened=[str(py)], budget_s=TEST_BUDGET_S), **LOCAL)
     state = {"models": [{"spec": str(py), "params": {"rho": 0.4}}]}
     m = c.post("/api/views", json=state).json()["models"][0]
     np.testing.assert_allclose(_slice0(m), 0.4 / math.pi, rtol=1e-9)
@@ -268,8 +271,9 @@ def test_api_python_file_reload(tmp_path):
 
 # --------------------------------------------------------------------------- the browser
 def _url(base, specs):
-    models = [{"spec": s, "params": {}, "pump": None, "times": 1, "visible": True} for s in specs]
-    return base + "#" + urllib.parse.quote(json.dumps({"models": models}))
+    """The short address the command prints (serve.start_url: ``#m=SPEC,SPEC``); the page
+    expands it to its full state (so these browser tests check the expansion too)."""
+    return base + "#m=" + ",".join(urllib.parse.quote(s, safe="") for s in specs)
 
 
 def _wait_verdict(page):
@@ -449,8 +453,13 @@ def test_explore_command_serves_file_specs(tmp_path):
     try:
         line = proc.stderr.readline()
         url = line.split("serving on ", 1)[1].split(" ", 1)[0]
-        state = json.loads(urllib.parse.unquote(url.split("#", 1)[1]))
-        assert [m["spec"] for m in state["models"]] == ["a.binary", str(b)]
+        # the short form (issue 20: a ~700-character state was printed before)
+        short = url.split("#", 1)[1]
+        assert short.startswith("m=") and len(url) < 60 + len(str(b)) * 2, url
+        specs = [urllib.parse.unquote(s) for s in short[2:].split(",")]
+        assert specs == ["a.binary", str(b)]
+        state = {"models": [{"spec": s, "params": {}, "pump": None, "times": 1,
+                             "visible": True} for s in specs]}
         base = f"http://127.0.0.1:{port}"
         for _ in range(100):
             try:
@@ -539,9 +548,15 @@ def _views(c, state):
 
 
 def _join_compiles(c):
-    for t in list(c.app.state.files.threads):
-        t.join(timeout=300)
-        assert not t.is_alive()
+    import asyncio
+
+    # the compiling threads are in the worker process: a job that joins them (in a thread
+    # of its own: Playwright's sync API may hold an event loop in this one)
+    job = c.app.state.worker.run("join", {"timeout": 300.0},
+                                 deadline=time.monotonic() + 310.0, what="join")
+    t = threading.Thread(target=asyncio.run, args=(job,))
+    t.start()
+    t.join()
 
 
 def test_api_formula_edit_draft_then_compiled(tmp_path):
@@ -560,7 +575,8 @@ def test_api_formula_edit_draft_then_compiled(tmp_path):
     k = 1.0 + float(rng.random())
     p.write_text(LAMBERT_BRDF.replace("rho / 3.14", f"{k!r} * rho / 3.14"))
     py.write_text(LAMBERT_PY.format(scale=k, name="rho"))
-    c = TestClient(create_app(opened=[str(py)]), **LOCAL)
+    c = TestClient(create_app(opened=[str(py)], allow_dirs=[tmp_path],
+                              budget_s=TEST_BUDGET_S), **LOCAL)
     for f, rtol in ((p, 1e-6), (py, 1e-12)):
         state = {"models": [{"spec": str(f), "params": {"rho": 0.4}}]}
         first = _views(c, state)

@@ -65,13 +65,15 @@ _TIMES_REASON = TIMES_REASON
 #: down. Larger values would wrap around (390 = 30) and are refused instead.
 THETA_MAX_DEG = 180.0
 
-PARAM_HELP = (
-    "Model parameter NAME=VALUE (repeatable). VALUE is a number, comma-separated "
+#: How a parameter's VALUE is written (one statement, shared by -p and --start).
+VALUE_HELP = (
+    "VALUE is a number, comma-separated "
     "numbers for per-channel colour or per-lobe parameters (e.g. rho_d=0.1,0.2,0.3), "
     "a word for choice parameters (e.g. distribution=ggx) or 'none' for optional ones. "
     "'beta' (lobe half-angle) is in DEGREES here (radians in the API). "
     "See 'brdfkit models' for each model's parameters."
 )
+PARAM_HELP = "Model parameter NAME=VALUE (repeatable). " + VALUE_HELP
 
 
 COMPENSATE_HELP = ("Compensate the energy lost to multiple scattering before any pumping: "

@@ -19,7 +19,7 @@ import click
 import numpy as np
 
 import brdfkit.cli._progress as _progress
-from brdfkit.cli._common import COMPENSATE_HELP, PARAM_HELP, emit_json
+from brdfkit.cli._common import COMPENSATE_HELP, VALUE_HELP, emit_json
 from brdfkit.cli._group import OneLineError, Stopped, one_line
 from brdfkit.errors import BrdfkitError
 from brdfkit.fitting import LOSSES, PROCEDURES  # the registries' names (--loss, --procedure)
@@ -32,7 +32,8 @@ __all__ = ["fit_cmd"]
 @click.command("fit")
 @click.argument("models", nargs=-1, required=True, metavar="MODEL...")
 @click.option("-p", "--param", "param", multiple=True, metavar="NAME=VALUE",
-              help="Hold a parameter of MODEL fixed (repeatable; one MODEL only). " + PARAM_HELP)
+              help="Hold parameter NAME of MODEL fixed at VALUE (repeatable; one MODEL "
+                   "only). " + VALUE_HELP)
 @click.option("--start", "start", multiple=True, metavar="NAME=VALUE",
               help="Start a parameter at VALUE and fit it (-p holds it instead); frees an "
                    "optional one that is off by default, e.g. --start eta=1.5 fits a "

@@ -28,6 +28,7 @@ from brdfkit.render.mitsuba_bridge import (
     MAX_SAMPLES,
     MITSUBA_MAX_SIZE,
     SEED_LIMIT,
+    VARIANTS,
     check_samples,
 )
 from brdfkit.render.silhouette import DEFAULT_ANTIALIAS, MAX_ANTIALIAS
@@ -84,6 +85,9 @@ def render_group() -> None:
 @click.option("--seed", type=click.IntRange(0, SEED_LIMIT - 1), default=0, show_default=True,
               help=f"Sampler seed of --engine mitsuba, 0 to {SEED_LIMIT - 1} (Mitsuba's seeds "
                    "are 32-bit; the render is deterministic given it).")
+@click.option("--variant", default=None, metavar="NAME",
+              help=f"Mitsuba variant of --engine mitsuba: {', '.join(VARIANTS)} (default "
+                   "llvm_ad_rgb; mono renders luminance); the direct engine takes none.")
 @click.option("--antialias", type=int, default=None, metavar="N",
               help=f"Direct engine: sub-samples per axis of each pixel the sphere's rim "
                    f"crosses, averaged (1 to {MAX_ANTIALIAS}; default {DEFAULT_ANTIALIAS}: "
@@ -97,7 +101,7 @@ def render_group() -> None:
                    "float64). Written atomically.")
 @click.option("--json", "as_json", is_flag=True, help="Print the render's metadata as JSON.")
 def sphere_cmd(model, param, compensate, pump, times, phi_l, ambient, irradiance, size, engine,
-               spp, seed, antialias, exposure, out, as_json):
+               spp, seed, variant, antialias, exposure, out, as_json):
     """Render MODEL on Lewis's sphere test configuration (Lewis 1993, Fig. 2).
 
     An S x S orthographic image of the unit sphere seen from +z, one
@@ -112,7 +116,13 @@ def sphere_cmd(model, param, compensate, pump, times, phi_l, ambient, irradiance
     if antialias is not None and not 1 <= antialias <= MAX_ANTIALIAS:
         raise BrdfkitError(f"--antialias must be an integer from 1 to {MAX_ANTIALIAS}; got "
                            f"{antialias}")
-    aa = {} if engine == "mitsuba" else {"antialias": antialias or DEFAULT_ANTIALIAS}
+    if engine == "direct" and variant is not None:
+        raise BrdfkitError(f"--variant {variant}: the direct engine is exact and runs no "
+                           "Mitsuba; drop --variant (it is for --engine mitsuba)")
+    if variant is not None and variant not in VARIANTS:
+        raise BrdfkitError(f"--variant must be one of {', '.join(VARIANTS)}; got {variant!r}")
+    aa = ({"variant": variant} if variant else {}) if engine == "mitsuba" else \
+        {"antialias": antialias or DEFAULT_ANTIALIAS}
     if engine == "direct" and spp is not None:
         raise BrdfkitError(f"--spp {spp}: the direct engine is exact and takes no samples; "
                            "drop --spp (it is for --engine mitsuba)")

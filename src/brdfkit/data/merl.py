@@ -83,6 +83,9 @@ N_BINS = SHAPE[0] * SHAPE[1] * SHAPE[2]  # 1,458,000 per channel
 SCALES = np.array([1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0])
 _HEADER_BYTES = 12
 _FILE_BYTES = _HEADER_BYTES + 3 * N_BINS * 8
+#: A header dimension shown in an error: MERL's layouts have ≤ 360 bins per axis; larger or
+#: non-positive values are other bytes (text, another format), not echoed.
+_MAX_SHOWN_DIM = 1024
 
 
 # --------------------------------------------------------------------------- the table
@@ -133,6 +136,10 @@ class MerlTable:
         return cls(v / SCALES[:, None, None, None], source)
 
 
+def _dims_like(dims) -> bool:
+    return all(0 < int(x) <= _MAX_SHOWN_DIM for x in dims)
+
+
 def read_binary(path) -> MerlTable:
     """Read a MERL ``.binary`` file (layout in the module docstring).
 
@@ -163,9 +170,19 @@ def read_binary(path) -> MerlTable:
         with open(p, "rb") as fh:
             dims = np.fromfile(fh, dtype="<i4", count=3)
             if tuple(int(x) for x in dims) != SHAPE:
+                # dimensions a table could have are shown; other bytes are not echoed (the
+                # explorer reports this message for a path from a request: no file content)
+                swapped = dims.byteswap()
+                if _dims_like(dims):
+                    found = f"({', '.join(str(int(x)) for x in dims)})"
+                elif _dims_like(swapped):
+                    found = (f"({', '.join(str(int(x)) for x in swapped)}) read big-endian "
+                             "(MERL files are little-endian)")
+                else:
+                    found = "bytes that are not table dimensions"
                 raise DataFileError(
-                    f"{p}: header: expected dimensions (90, 90, 180); found "
-                    f"({', '.join(str(int(x)) for x in dims)}) — not a MERL isotropic .binary")
+                    f"{p}: header: expected dimensions (90, 90, 180); found {found} — not a "
+                    "MERL isotropic .binary")
             if size != _FILE_BYTES:
                 what = "truncated" if size < _FILE_BYTES else "too long"
                 raise DataFileError(

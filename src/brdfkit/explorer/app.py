@@ -38,6 +38,14 @@ polls ``/api/changes`` with it and redraws when a file changed. ``/api/open`` ta
 request from this machine only and is the one way a Python file (which runs code) is
 loaded besides the command line (``files`` module docstring, "Security").
 
+Robust under a stranger's hands (issue 19): every request passes
+:mod:`brdfkit.explorer.guard` (the ``Host`` a served name, writes from the explorer's own
+page only, bounded sizes, files only those the user gave), and every computation runs in
+the worker process within the request's time budget (:mod:`brdfkit.explorer.worker`): the
+server keeps answering while a model computes, a model over the budget comes back as
+``{"spec", "error"}`` naming the budget, and Ctrl-C stops the server at once. Bad input
+is a 400 with one line ``{"error"}``, never a traceback.
+
 Why FastAPI and not Panel: a slider move must redraw every view in 100 ms, and
 measured (``benchmarks/bench_explorer.py``, one analytic model) a direction move
 costs ~32 ms end to end, ~10 ms of it the views and the rest JSON encoding of the
@@ -48,59 +56,59 @@ drives directly (Panel/Bokeh render in shadow DOM). Panel itself was not
 benchmarked here.
 """
 
-import base64
-import itertools
 import json
 import math
-import tempfile
-import threading
 import time
-import urllib.parse
+import weakref
+from contextlib import asynccontextmanager
 from importlib import resources
-from pathlib import Path
 
 from fastapi import FastAPI, Request
 from fastapi.responses import HTMLResponse, JSONResponse, Response
 from starlette.concurrency import run_in_threadpool
 
 from brdfkit._cache import bounded_cache
-from brdfkit._io import to_jsonable
 from brdfkit.data import material_names
 from brdfkit.data.catalog import MATERIAL_SOURCES
-from brdfkit.data.export import export_merl
 from brdfkit.errors import BrdfkitError
-from brdfkit.explorer import files, views
+from brdfkit.explorer import files, guard
+from brdfkit.explorer.compute import build_entry, entry_spec, error_entry
+from brdfkit.explorer.worker import BUDGET_S, Fits, OverBudget, Worker
 from brdfkit.models import MODELS
-from brdfkit.spec import MAX_TIMES, ModelSpec
+from brdfkit.spec import MAX_TIMES
 
 __all__ = ["create_app", "build_entry", "entry_spec", "parse_state"]
 
-#: Models and view sets kept per app (LRU): a session flips between a few models; a pumped
-#: model holds its tables (up to a few MB)
-_CACHE_SIZE = 64
+#: Bytes of an oversized body read (and discarded) before answering 413: a client sending
+#: a little too much gets the message rather than a broken pipe; beyond this, the reply.
+_DRAIN_BYTES = 64 * guard.MAX_BODY_BYTES
+#: Models remembered as over the budget (a page shows 8; a few pages, a few edits).
+_COSTLY_SIZE = 64
 
 
 def _number(state: dict, key: str, default: float, lo: float, hi: float) -> float:
     v = state.get(key, default)
     try:
         x = float(v)
-    except (TypeError, ValueError):
-        raise BrdfkitError(f"{key} must be a number in [{lo:g}, {hi:g}]; got {v!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise guard.RequestError(f"{key} must be a number in [{lo:g}, {hi:g}]; "
+                                 f"got {v!r}"[:300]) from None
     if not lo <= x <= hi:
-        raise BrdfkitError(f"{key} must lie in [{lo:g}, {hi:g}]; got {x:g}")
+        raise guard.RequestError(f"{key} must lie in [{lo:g}, {hi:g}]; got {x:g}")
     return x
 
 
 def parse_state(state: dict) -> dict:
     """Validate a state (module docstring); angles converted to radians."""
     if not isinstance(state, dict):
-        raise BrdfkitError("the request body must be a JSON object (the explorer state)")
+        raise guard.RequestError("the request body must be a JSON object (the explorer state)")
     models = state.get("models", [])
-    if not isinstance(models, list) or len(models) > 8:
-        raise BrdfkitError("models must be a list of at most 8 entries")
+    if not isinstance(models, list) or len(models) > guard.MAX_MODELS:
+        raise guard.RequestError(f"models must be a list of at most {guard.MAX_MODELS} entries "
+                                 "(MAX_MODELS)")
     mode = state.get("mode", "luminance")
     if mode not in ("luminance", "rgb"):
-        raise BrdfkitError(f"mode must be 'luminance' or 'rgb'; got {mode!r}")
+        raise guard.RequestError(f"mode must be 'luminance' or 'rgb'; got {mode!r}"[:300])
     return {
         "models": models,
         "theta_i": math.radians(_number(state, "theta_i", 30.0, 0.0, 89.5)),
@@ -112,123 +120,156 @@ def parse_state(state: dict) -> dict:
     }
 
 
-def entry_spec(entry: dict) -> ModelSpec:
-    """The :class:`~brdfkit.spec.ModelSpec` of one state entry ``{"spec", "params",
-    "compensate", "pump", "times"}``: the spec's flat dict form with the page's
-    conventions — the name under ``spec``, empty fields dropped, ``beta`` in degrees (as
-    on the command line)."""
-    params = _page_params(entry)
-    if "beta" in params:  # degrees in the UI, as on the command line
-        params["beta"] = math.radians(float(params["beta"]))
-    return ModelSpec.from_dict({"model": entry["spec"], "params": params,
-                                **{k: entry[k] for k in ("compensate", "pump", "times")
-                                   if k in entry}})
-
-
-def _page_params(entry: dict) -> dict:
-    """An entry's parameters as the page sends them, empty fields dropped."""
-    if not isinstance(entry, dict) or not isinstance(entry.get("spec"), str):
-        raise BrdfkitError("each model entry needs a 'spec' string (a model name or material)")
-    params = entry.get("params") or {}
-    if not isinstance(params, dict):
-        raise BrdfkitError(f"{entry['spec']}: params must be an object NAME: VALUE")
-    return {k: v for k, v in params.items() if v is not None and v != ""}
-
-
-#: Names a request from this machine uses for the server (Host) and comes from (client).
-_LOOPBACK = ("127.0.0.1", "::1", "localhost")
-
-
 def _from_this_machine(request: Request) -> bool:
-    """The request comes from this machine, to a loopback name, and — when a browser
-    says which page sent it (``Origin``) — from the explorer's own page: another site
-    open in the browser cannot post it, nor a DNS-rebound name reach it."""
-    host = request.headers.get("host", "")
-    hostname = urllib.parse.urlsplit("//" + host).hostname or ""
-    origin = request.headers.get("origin")
-    return (request.client is not None and request.client.host in _LOOPBACK
-            and hostname in _LOOPBACK and origin in (None, f"http://{host}"))
-
-
-def build_entry(entry: dict):
-    """A model from one state entry ``{"spec", "params", "pump", "times"}``
-    (:func:`entry_spec`, built)."""
-    return entry_spec(entry).build()
+    """The request comes from this machine (its client address is loopback); the Host
+    and Origin checks of every write are :func:`guard.refusal`'s."""
+    return request.client is not None and request.client.host in guard.LOOPBACK
 
 
 async def _body(request: Request):
-    """The request's JSON body, or a BrdfkitError saying what was wrong with it."""
-    try:
-        return json.loads(await request.body())
-    except (ValueError, UnicodeDecodeError) as exc:
-        raise BrdfkitError(f"the request body must be JSON (the explorer state): {exc}") from None
+    """The request's JSON body (at most MAX_BODY_BYTES kept, read in chunks), or a
+    RequestError saying what was wrong with it. A larger body is read to its end (up to
+    _DRAIN_BYTES, discarded) so that the client receives the 413 instead of a broken pipe."""
+    chunks, size = [], 0
+    async for chunk in request.stream():
+        size += len(chunk)
+        if size <= guard.MAX_BODY_BYTES:
+            chunks.append(chunk)
+        elif size > _DRAIN_BYTES:
+            break
+    if size > guard.MAX_BODY_BYTES:
+        raise guard.too_large(size)
+    return guard.read_json(b"".join(chunks))
 
 
-def _b64(png: bytes) -> str:
-    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
+class _Guard:
+    """ASGI middleware: refuse a request whose Host or Origin is not the explorer's, or a
+    write that is not JSON (:func:`guard.refusal`), before any route runs."""
+
+    def __init__(self, app, names: frozenset[str]):
+        self.app, self.names = app, names
+
+    async def __call__(self, scope, receive, send):
+        if scope["type"] == "http":
+            h = {k.decode("latin-1").lower(): v.decode("latin-1") for k, v in scope["headers"]}
+            bad = guard.refusal(method=scope["method"], host=h.get("host", ""),
+                                origin=h.get("origin"), content_type=h.get("content-type"),
+                                names=self.names)
+            if bad is not None:
+                await JSONResponse({"error": str(bad)}, status_code=bad.status)(
+                    scope, receive, send)
+                return
+        await self.app(scope, receive, send)
 
 
-def _warm(m) -> None:
-    """Evaluate a just-compiled file model as the page will (the views at one direction:
-    Numba compiles their loops in the compiling thread, not in the page's request)."""
-    views.sphere(m, phi_l=0.5)
-    views.polar(m, 0.5), views.lobe(m, 0.5), views.curves(m, 0.5), views.halfdiff(m)
-    views.albedo_curve(m)
+def create_app(*, opened=(), allow_dirs=(), host: str = "127.0.0.1",
+               budget_s: float = BUDGET_S):
+    """The FastAPI application (one worker process per app, started on first use);
+    *opened*: files the user named (the command line's specs; a Python file among them may
+    run code); *allow_dirs*: directories whose data files any request may open
+    (``--allow-dir``); *host*: the address served (the Host names accepted,
+    :func:`guard.served_names`); *budget_s*: seconds a request may compute."""
+    if not (isinstance(budget_s, int | float) and 0 < budget_s <= 86400):
+        raise BrdfkitError(f"--budget must be a number of seconds in (0, 86400]; "
+                           f"got {budget_s!r}")
+    access = guard.FileAccess(given=[p for p in map(files.spec_file, opened) if p],
+                              dirs=allow_dirs)
+    watcher = files.FileWatcher()
+    worker = Worker(on_mark=watcher.mark)
+    # models that ran over the budget on a warm worker (LRU): the same model in the next
+    # request (the page's verdict, a light move) is answered at once instead of stopping
+    # the worker once more; another 'times' or parameter is another model
+    too_costly = bounded_cache(None, maxsize=_COSTLY_SIZE)
+    fits = Fits()
 
+    @asynccontextmanager
+    async def lifespan(app):
+        worker.start()  # warm while the page loads
+        yield
+        worker.stop()
+        fits.stop()
 
-def create_app(*, opened=()):
-    """The FastAPI application (one model cache per app); *opened*: files the user named
-    (the command line's specs), which may run code (:mod:`brdfkit.explorer.files`)."""
-    app = FastAPI(title="brdfkit explorer", docs_url=None, redoc_url=None)
-    cache = bounded_cache(None, maxsize=_CACHE_SIZE)  # this app's models and views
+    app = FastAPI(title="brdfkit explorer", docs_url=None, redoc_url=None,
+                  openapi_url=None, lifespan=lifespan)
+    app.add_middleware(_Guard, names=guard.served_names(host))
     static = resources.files("brdfkit.explorer") / "static"
-    from_files = files.FileModels(opened=[p for p in map(files.spec_file, opened) if p],
-                                  warm=_warm)
-    app.state.files = from_files  # the tests join its compiling threads
+    app.state.worker, app.state.access, app.state.watcher = worker, access, watcher
+    # an app dropped without its lifespan's end (a test client used without `with`): its
+    # processes end with it
+    weakref.finalize(app, worker.stop)
+    weakref.finalize(app, fits.stop)
+    app.state.budget_s = budget_s
 
-    def _key(entry: dict) -> str:
-        return json.dumps({k: entry.get(k) for k in ("spec", "params", "pump", "times")},
-                          sort_keys=True)
+    over = (f"not done: over the explorer's time budget of {budget_s:g} s per request, "
+            "stopped (a pumped model with a large 'times' takes longest: lower 'times', "
+            "or start brdfkit explore with a larger --budget)")
 
-    def _cached(key, make):
-        got = cache.get(key)
-        if got is None:
-            got = cache[key] = make()
-        return got
+    async def run(kind: str, payload: dict, what: str):
+        """One whole job within the budget; over it, a 503 naming the budget."""
+        try:
+            return (await worker.run(kind, payload, deadline=time.monotonic() + budget_s,
+                                     what=what))[0]
+        except OverBudget as exc:
+            if not exc.started:
+                raise
+            raise OverBudget(f"{what}: {over}", {}, started=True) from None
 
-    def get_built(entry: dict) -> tuple:
-        """``(model, info)``: *info* empty for a model not from a file (module docstring)."""
-        _page_params(entry)
+    def checked(entries: list) -> tuple[list, dict]:
+        """The entries a request may compute, and ``{index: error entry}`` of the others."""
+        ok, refused = [], {}
+        for i, e in enumerate(entries):
+            try:
+                guard.check_entry(e)
+                access.check(e["spec"])
+                ok.append((i, e))
+            except guard.RequestError as exc:
+                refused[i] = error_entry(e, str(exc))
+        return ok, refused
+
+    def digests(entries) -> dict:
+        """The content hashes of the entries' files (watched from now on)."""
+        out = {}
+        for _, e in entries:
+            path = files.spec_file(e["spec"])
+            if path is not None:
+                out[path] = watcher.digest(path)
+        return out
+
+    def costly_key(entry: dict, found: dict) -> str:
         path = files.spec_file(entry["spec"])
-        if path is None:
-            return _cached(_key(entry), lambda: (build_entry(entry), {}))
-        digest = from_files.watcher.digest(path)
-        stage = from_files.stage(entry["spec"], path, digest)  # a draft, then compiled
-        key = _key(entry) + "|file|" + str(digest) + "|" + stage
-        return _cached(key, lambda: from_files.build(
-            entry["spec"], path, digest, _page_params(entry),
-            lambda kept: entry_spec({**entry, "params": kept})))
+        return json.dumps([entry.get(k) for k in ("spec", "params", "pump", "times",
+                                                  "compensate")] + [found.get(path)])
 
-    def get_model(entry: dict):
-        return get_built(entry)[0]
-
-    def model_only(entry: dict, m, info: dict, mode: str, phi_i: float) -> dict:
-        """Views that depend on the model alone (not on the direction or the light):
-        computed once per model and channel mode, so moving θ_i, φ_i or Φ_L skips them
-        (an anisotropic model's albedo curve is at φ_i: computed once per φ_i)."""
-        phi = 0.0 if m.isotropic else phi_i
-
-        def make():
-            png_h, hd = views.halfdiff(m)
-            return {"albedo": views.albedo_curve(m, mode=mode, phi=phi),
-                    "halfdiff": _b64(png_h), "halfdiff_info": hd}
-        return _cached(_key(entry) + "|" + info.get("digest", "") + "|views|" + mode
-                       + ("" if info.get("compiled", True) else "|interpreted")
-                       + ("" if m.isotropic else f"|{phi!r}"), make)
+    async def per_model(kind: str, s: dict) -> tuple[list, int]:
+        ok, out = checked(s["models"])
+        version = watcher.version
+        found = await run_in_threadpool(digests, ok)
+        for i, e in ok:  # known to exceed the budget: answered at once (reason: too_costly)
+            if costly_key(e, found) in too_costly:
+                out[i] = error_entry(e, f"{e['spec'][:200]}: {over}")
+        ok = [(i, e) for i, e in ok if i not in out]
+        if not ok:
+            return [out[i] for i in range(len(s["models"]))], version
+        payload = {"entries": [e for _, e in ok], "state": s, "given": sorted(access.given),
+                   "digests": found}
+        deadline = time.monotonic() + budget_s
+        try:
+            _, parts = await worker.run(kind, payload, deadline=deadline, what=kind,
+                                        low=kind == "verdicts")
+            message = over
+        except OverBudget as exc:
+            parts, message = exc.parts, over if exc.started else str(exc)
+            slow = next((k for k in range(len(ok)) if k not in exc.parts), None)
+            if exc.warm and slow is not None:  # the model computing at the deadline
+                too_costly[costly_key(ok[slow][1], found)] = True
+        for k, (i, e) in enumerate(ok):
+            out[i] = parts[k] if k in parts else error_entry(e, f"{e['spec'][:200]}: {message}")
+        return [out[i] for i in range(len(s["models"]))], version
 
     @app.exception_handler(BrdfkitError)
     async def _brdfkit_error(request: Request, exc: BrdfkitError):
-        return JSONResponse({"error": str(exc)}, status_code=400)
+        status = 503 if isinstance(exc, OverBudget) else getattr(exc, "status", 400)
+        return JSONResponse({"error": str(exc)}, status_code=status)
 
     @app.exception_handler(Exception)
     async def _any_error(request: Request, exc: Exception):  # never a traceback in the page
@@ -246,7 +287,7 @@ def create_app(*, opened=()):
     @app.get("/static/{name}")
     def static_file(name: str):
         if name not in ("app.js", "style.css"):
-            return JSONResponse({"error": f"no such file {name!r}"}, status_code=404)
+            return JSONResponse({"error": f"no such file {name[:100]!r}"}, status_code=404)
         kind = "text/javascript" if name.endswith(".js") else "text/css"
         return Response((static / name).read_text(encoding="utf-8"), media_type=kind)
 
@@ -258,52 +299,23 @@ def create_app(*, opened=()):
 
     @app.post("/api/views")
     async def all_views(request: Request):
-        s = parse_state(await _body(request))
-        # computed in a worker thread: the event loop keeps answering /api/changes
-        return await run_in_threadpool(compute_views, s)
-
-    def compute_views(s: dict) -> dict:
         t0 = time.perf_counter()
-        version = from_files.watcher.version
-        out = []
-        for entry in s["models"]:
-            try:
-                m, info = get_built(entry)
-                png_s, sph = views.sphere(m, phi_l=s["phi_l"], ambient=s["ambient"])
-                out.append({
-                    **info,
-                    "spec": entry.get("spec"), "name": m.name, "params": m.to_dict()["params"],
-                    "polar": views.polar(m, s["theta_i"], s["phi_i"], cosine=s["cosine"],
-                                         mode=s["mode"]),
-                    "lobe": views.lobe(m, s["theta_i"], s["phi_i"]),
-                    "curves": views.curves(m, s["theta_i"], s["phi_i"], cosine=s["cosine"],
-                                           mode=s["mode"]),
-                    "sphere": _b64(png_s), "sphere_info": sph,
-                    "reciprocal_claim": m.reciprocal,
-                    **model_only(entry, m, info, s["mode"], s["phi_i"]),
-                })
-            except BrdfkitError as exc:
-                spec = entry.get("spec") if isinstance(entry, dict) else None
-                path = files.spec_file(spec)
-                out.append({"spec": spec, "error": str(exc),
-                            **({"file": path} if path else {})})
-        from_files.start_compiles()  # the drafts drawn: compile them now (files docstring)
-        return to_jsonable({"models": out, "version": version,
-                            "ms": round(1e3 * (time.perf_counter() - t0), 1)})
+        s = parse_state(await _body(request))
+        out, version = await per_model("views", s)
+        return {"models": out, "version": version,
+                "ms": round(1e3 * (time.perf_counter() - t0), 1)}
 
     @app.post("/api/verdict")
     async def verdicts(request: Request):
         s = parse_state(await _body(request))
-        return await run_in_threadpool(compute_verdicts, s)
+        out, _ = await per_model("verdicts", s)
+        return {"verdicts": out}
 
-    def compute_verdicts(s: dict) -> dict:
-        out = []
-        for entry in s["models"]:
-            try:
-                out.append(views.verdict(get_model(entry), phi=s["phi_i"]))
-            except BrdfkitError as exc:
-                out.append({"spec": entry.get("spec"), "error": str(exc)})
-        return to_jsonable({"verdicts": out})
+    async def one_model(entry, what: str):
+        ok, refused = checked([entry])
+        if refused:
+            raise guard.RequestError(f"{what}: {refused[0]['error']}")
+        return ok[0][1]
 
     @app.post("/api/open")
     async def open_file(request: Request):
@@ -313,71 +325,49 @@ def create_app(*, opened=()):
                                 status_code=403)
         body = await _body(request)
         spec, path = files.check_open(body.get("path") if isinstance(body, dict) else None)
-        from_files.allow(path)  # the user typed it: it may run (a .py model)
+        access.allow(path)  # the user typed it: it may be opened (and, a .py model, run)
         return {"spec": spec, "file": path}
 
     @app.get("/api/changes")
     def changes(since: int = -1):
-        version = from_files.watcher.poll()
-        return {"version": version, "changed": from_files.watcher.changes(since)}
+        version = watcher.poll()
+        return {"version": version, "changed": watcher.changes(since)}
 
     @app.post("/api/export/binary")
     async def export_binary(request: Request):
-        entry = await _body(request)
-        m = get_model(entry)
-        with tempfile.TemporaryDirectory() as d:
-            path = Path(d) / "model.binary"
-            export_merl(m, path)
-            data = path.read_bytes()
-        name = "".join(c if c.isalnum() or c in "-_." else "_" for c in m.name) + ".binary"
+        entry = await one_model(await _body(request), "export")
+        name, data = await run("export", {
+            "entry": entry, "given": sorted(access.given),
+            "digests": await run_in_threadpool(digests, [(0, entry)])}, "export")
         return Response(data, media_type="application/octet-stream",
                         headers={"Content-Disposition": f'attachment; filename="{name}"'})
-
-    fits: dict[int, dict] = {}
-    fit_ids = itertools.count(1)
-
-    def run_fit(job_id: int, m, target, loss: str) -> None:
-        from brdfkit.fitting import fit
-
-        job = fits[job_id]
-
-        def progress(stage, evaluations, value):
-            job.update(stage=stage, evaluations=int(evaluations), loss=float(value))
-
-        try:
-            r = fit(m, target, loss=loss, progress=progress)
-            d = r.to_dict()
-            job.update(state="done", params=d["params"], metrics=d["metrics"],
-                       message=r.message, success=r.success)
-        except BrdfkitError as exc:
-            job.update(state="error", error=str(exc))
-        except Exception as exc:  # noqa: BLE001 - reported in the page, never a traceback
-            job.update(state="error", error=f"internal error: {type(exc).__name__}: {exc}")
-        finally:
-            job["seconds"] = round(time.perf_counter() - job["t0"], 2)
 
     @app.post("/api/fit")
     async def start_fit(request: Request):
         body = await _body(request)
-        if not isinstance(body, dict) or not isinstance(body.get("target"), str):
-            raise BrdfkitError("fit: give {'model': {...}, 'target': SPEC, 'loss': ...}")
+        if (not isinstance(body, dict) or not isinstance(body.get("target"), str)
+                or not isinstance(body.get("model"), dict)):
+            raise guard.RequestError("fit: give {'model': {'spec': ...}, 'target': SPEC, "
+                                     "'loss': ...}")
         loss = body.get("loss", "l1")
-        m = get_model(body.get("model"))
-        # through the model cache and, for a file, its guard (a .py target runs only opened)
-        target = get_model({"spec": body["target"]})
-        job_id = next(fit_ids)
-        fits[job_id] = {"state": "running", "stage": "starting", "evaluations": 0,
-                        "t0": time.perf_counter(), "model": m.name, "target": target.name}
-        threading.Thread(target=run_fit, args=(job_id, m, target, loss), daemon=True).start()
-        return {"id": job_id}
+        from brdfkit.fitting import LOSSES
+
+        if not isinstance(loss, str) or loss not in LOSSES:
+            raise guard.RequestError(f"fit: loss must be one of {', '.join(LOSSES)}; "
+                                     f"got {loss!r}"[:300])
+        model = await one_model(body["model"], "fit")
+        target = await one_model({"spec": body["target"]}, "fit target")
+        given = sorted(access.given)
+        # built in the worker first (within the budget): a bad spec is a 400 here
+        names = await run("names", {"entries": [model, target], "given": given}, "fit")
+        return {"id": fits.start(model=model, target=target, loss=loss, given=given,
+                                 names=names)}
 
     @app.get("/api/fit/{job_id}")
     def fit_status(job_id: int):
-        job = fits.get(job_id)
-        if job is None:
+        out = fits.status(job_id)
+        if out is None:
             return JSONResponse({"error": f"no fit {job_id}"}, status_code=404)
-        out = {k: v for k, v in job.items() if k != "t0"}
-        out.setdefault("seconds", round(time.perf_counter() - job["t0"], 2))
-        return to_jsonable(out)
+        return out
 
     return app

@@ -37,7 +37,8 @@ or typed into the page's "open file" box, whose request must come from this mach
 (client address, ``Host`` and ``Origin`` all loopback: another web site open in the
 browser cannot post one, a DNS-rebound name is refused). A ``.py`` spec arriving any
 other way (a shared link's state) is refused with a message saying to open it first.
-Data files (``.binary``, ``.brdf``) run no code and load from a link as before.
+Data files (``.binary``, ``.brdf``) run no code; a link may name one the user gave or one
+under ``--allow-dir`` (:class:`brdfkit.explorer.guard.FileAccess`).
 
 Public objects
 --------------
@@ -58,7 +59,7 @@ from brdfkit._cache import bounded_cache
 from brdfkit.errors import BrdfkitError, DataFileError
 from brdfkit.spec import KINDS, OPERATORS
 
-__all__ = ["spec_file", "runs_code", "check_open", "FileWatcher", "FileModels",
+__all__ = ["spec_file", "runs_code", "check_open", "content_digest", "FileWatcher", "FileModels",
            "POLL_INTERVAL_S", "MAX_WATCHED"]
 
 #: A poll newer than this is reused: several pages polling every 100 ms stat each file
@@ -116,6 +117,14 @@ def check_open(text) -> tuple[str, str]:
         raise DataFileError(f"open file: {shown}: {why} (paths are on the machine that runs "
                             f"brdfkit explore; relative to {os.getcwd()})")
     return spec, path
+
+
+def content_digest(path: str) -> str | None:
+    """SHA-256 of the file's bytes (hex), or None when it cannot be read now."""
+    try:
+        return _digest(path)
+    except OSError:
+        return None
 
 
 def _digest(path: str) -> str:
@@ -226,10 +235,13 @@ class FileModels:
     """Builds file-backed models for one app (module docstring); *opened*: the files
     the user named on the command line (allowed to run code); *warm*: ``warm(model)``
     evaluates a just-compiled model once (the views it will draw), in the compiling
-    thread."""
+    thread; *watcher*: whose ``mark(path)`` is called when a compiled model is ready (a
+    :class:`FileWatcher` of its own by default; the explorer's worker reports to the web
+    server's instead).
+    """
 
-    def __init__(self, *, opened=(), warm=None):
-        self.watcher = FileWatcher()
+    def __init__(self, *, opened=(), warm=None, watcher=None):
+        self.watcher = FileWatcher() if watcher is None else watcher
         self._warm = warm
         self._lock = threading.Lock()
         # (target, digest) -> (path, params) of a draft to compile; those started

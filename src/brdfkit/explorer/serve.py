@@ -5,15 +5,19 @@
 :func:`serve` runs the app (:func:`brdfkit.explorer.app.create_app`) with
 uvicorn on **127.0.0.1** only — nobody else on the network can reach it unless
 ``host`` is given explicitly — opens the browser unless told not to, and stops
-cleanly on Ctrl-C (uvicorn's shutdown; no traceback). The specs given are the
-page's first models; those that are files (``my.brdf``, ``model.py:NAME``, a MERL
-``.binary``) are watched and reloaded in the open page when saved, and a Python file
-named here may run (:mod:`brdfkit.explorer.files`).
+cleanly on Ctrl-C or SIGTERM within :data:`~brdfkit.explorer.worker.SHUTDOWN_GRACE_S`
+even while a model computes (uvicorn's shutdown, then the worker process killed; no
+traceback). The specs given are the page's first models; those that are files
+(``my.brdf``, ``model.py:NAME``, a MERL ``.binary``) are watched and reloaded in the open
+page when saved, and a Python file named here may run (:mod:`brdfkit.explorer.files`).
+Requests may open those files, files typed into the page's "open file", and data files
+under ``allow_dirs`` (:mod:`brdfkit.explorer.guard`); each request computes for at most
+*budget_s* seconds (:mod:`brdfkit.explorer.worker`).
 """
 
 from __future__ import annotations
 
-import json
+import logging
 import threading
 import urllib.parse
 import webbrowser
@@ -27,12 +31,12 @@ LOCALHOST = "127.0.0.1"
 
 
 def start_url(host: str, port: int, specs=()) -> str:
-    """The page's address, with *specs* as the initial models in the URL state."""
+    """The page's address, with *specs* as the initial models in the short URL state
+    ``#m=SPEC,SPEC`` (each spec percent-encoded, a comma too), which the page expands to
+    its full state (the models at their defaults)."""
     url = f"http://{host}:{port}/"
     if specs:
-        state = {"models": [{"spec": s, "params": {}, "pump": None, "times": 1, "visible": True}
-                            for s in specs]}
-        url += "#" + urllib.parse.quote(json.dumps(state))
+        url += "#m=" + ",".join(urllib.parse.quote(str(s), safe="") for s in specs)
     return url
 
 
@@ -51,12 +55,21 @@ def _check_free(host: str, port: int) -> None:
 
 
 def serve(*, specs=(), host: str = LOCALHOST, port: int = DEFAULT_PORT, open_browser: bool = True,
-          log=print) -> None:
-    """Serve until Ctrl-C. *specs* (model names or material specs) are validated first."""
+          allow_dirs=(), budget_s: float | None = None, log=print) -> None:
+    """Serve until Ctrl-C. *specs* (model names or material specs) are validated first;
+    *allow_dirs* must be directories."""
+    import os
+
     import uvicorn
 
     from brdfkit.explorer.app import create_app
+    from brdfkit.explorer.worker import BUDGET_S, SHUTDOWN_GRACE_S
     from brdfkit.spec import canonical_name
+
+    for d in allow_dirs:
+        if not os.path.isdir(d):
+            raise BrdfkitError(f"--allow-dir {d}: not a directory (give a directory whose "
+                               "model files the page may open)")
 
     if not (isinstance(port, int) and 0 < port < 65536):
         raise BrdfkitError(f"--port must be an integer from 1 to 65535; got {port!r}")
@@ -67,8 +80,16 @@ def serve(*, specs=(), host: str = LOCALHOST, port: int = DEFAULT_PORT, open_bro
     where = ("this machine only" if host == LOCALHOST else
              f"every machine that can reach {host} (--host given)")
     log(f"brdfkit explore: serving on {url} ({where}); Ctrl-C stops")
-    config = uvicorn.Config(create_app(opened=specs), host=host, port=port,
-                            log_level="warning")
+    app = create_app(opened=specs, allow_dirs=allow_dirs, host=host,
+                     budget_s=BUDGET_S if budget_s is None else budget_s)
+    # the shutdown waits SHUTDOWN_GRACE_S for running requests, then cancels them (their
+    # worker is killed): Ctrl-C stops the server at once even mid-computation
+    config = uvicorn.Config(app, host=host, port=port, log_level="warning",
+                            timeout_graceful_shutdown=SHUTDOWN_GRACE_S)
+    # the requests cancelled at shutdown are ours to cancel (their worker is killed): not an
+    # error for the user
+    logging.getLogger("uvicorn.error").addFilter(
+        lambda r: "timeout graceful shutdown exceeded" not in r.getMessage())
     server = uvicorn.Server(config)
     if open_browser:
         threading.Timer(1.0, lambda: webbrowser.open(url)).start()

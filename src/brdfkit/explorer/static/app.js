@@ -30,6 +30,12 @@ function defaultState() {
 
 function readHash() {
   if (!location.hash || location.hash.length < 2) return defaultState();
+  // the short form the command line prints: #m=SPEC,SPEC (each percent-encoded)
+  if (location.hash.startsWith("#m=")) {
+    const specs = location.hash.slice(3).split(",").filter(s => s).map(decodeURIComponent);
+    return Object.assign(defaultState(), {
+      models: specs.map(spec => ({ spec, params: {}, pump: null, times: 1, visible: true })) });
+  }
   try {
     return Object.assign(defaultState(), JSON.parse(decodeURIComponent(location.hash.slice(1))));
   } catch (e) {

@@ -1,0 +1,199 @@
+"""
+What the explorer computes, in its worker process
+=================================================
+
+:class:`Session` holds one worker's models (an LRU cache keyed on the full description
+and, for a file, its content hash) and its file models (:class:`~brdfkit.explorer.files.
+FileModels`), and computes one model's views, verdict or MERL export. It runs in the
+worker process (:mod:`brdfkit.explorer.worker`), never on the web server's event loop:
+Numba's kernels hold the GIL, so a long computation there would stop every other request.
+The requests reaching it were checked by :mod:`brdfkit.explorer.guard`.
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+import tempfile
+from pathlib import Path
+
+from brdfkit._cache import bounded_cache
+from brdfkit._io import to_jsonable
+from brdfkit.data.export import export_merl
+from brdfkit.errors import BrdfkitError
+from brdfkit.explorer import files, guard, views
+from brdfkit.spec import ModelSpec
+
+__all__ = ["Session", "entry_spec", "build_entry", "warm"]
+
+#: Models and view sets kept per session (LRU): a session flips between a few models; a
+#: pumped model holds its tables (up to a few MB)
+_CACHE_SIZE = 64
+
+
+def entry_spec(entry: dict) -> ModelSpec:
+    """The :class:`~brdfkit.spec.ModelSpec` of one state entry ``{"spec", "params",
+    "compensate", "pump", "times"}``: the spec's flat dict form with the page's
+    conventions — the name under ``spec``, empty fields dropped, ``beta`` in degrees (as
+    on the command line)."""
+    params = page_params(entry)
+    if "beta" in params:  # degrees in the UI, as on the command line
+        params["beta"] = guard.check_beta(entry["spec"], params["beta"])
+    return ModelSpec.from_dict({"model": entry["spec"], "params": params,
+                                **{k: entry[k] for k in ("compensate", "pump", "times")
+                                   if k in entry}})
+
+
+def page_params(entry: dict) -> dict:
+    """An entry's parameters as the page sends them, empty fields dropped."""
+    guard.check_entry(entry)
+    params = entry.get("params") or {}
+    return {k: v for k, v in params.items() if v is not None and v != ""}
+
+
+def build_entry(entry: dict):
+    """A model from one state entry (:func:`entry_spec`, built)."""
+    return entry_spec(entry).build()
+
+
+def _b64(png: bytes) -> str:
+    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
+
+
+def warm(m) -> None:
+    """Evaluate a just-compiled file model as the page will (the views at one direction:
+    Numba compiles their loops in the compiling thread, not in the page's request)."""
+    views.sphere(m, phi_l=0.5)
+    views.polar(m, 0.5), views.lobe(m, 0.5), views.curves(m, 0.5), views.halfdiff(m)
+    views.albedo_curve(m)
+
+
+def _check_channels(m) -> None:
+    n = m.n_channels or 1
+    if n not in (1, guard.MAX_CHANNELS):
+        raise BrdfkitError(f"{m.name}: the explorer draws grey (1) or RGB ({guard.MAX_CHANNELS})"
+                           f" channels; this model has {n} (give 1 or 3 values per colour "
+                           "parameter; brdfkit render draws other counts to .exr/.npy)")
+
+
+class Session:
+    """One worker's models (module docstring). *mark(path)*: called when a file's compiled
+    model is ready (the web server raises that file's watch version)."""
+
+    def __init__(self, *, mark=None):
+        self.cache = bounded_cache(None, maxsize=_CACHE_SIZE)
+        self._digests: dict[str, str | None] = {}
+        watcher = _Marks(self, mark)
+        self.files = files.FileModels(warm=warm, watcher=watcher)
+
+    def allow(self, paths) -> None:
+        """The files the user named (they may run code)."""
+        for p in paths:
+            self.files.allow(p)
+
+    def set_digests(self, digests: dict) -> None:
+        """The content hashes the web server's watcher gave this request's files."""
+        self._digests = dict(digests)
+
+    @staticmethod
+    def _key(entry: dict) -> str:
+        return json.dumps({k: entry.get(k) for k in ("spec", "params", "pump", "times")},
+                          sort_keys=True)
+
+    def _cached(self, key, make):
+        got = self.cache.get(key)
+        if got is None:
+            got = self.cache[key] = make()
+        return got
+
+    def get_built(self, entry: dict) -> tuple:
+        """``(model, info)``: *info* empty for a model not from a file (app docstring)."""
+        page_params(entry)
+        path = files.spec_file(entry["spec"])
+        if path is None:
+            m, info = self._cached(self._key(entry), lambda: (build_entry(entry), {}))
+        else:
+            digest = (self._digests[path] if path in self._digests
+                      else files.content_digest(path))
+            stage = self.files.stage(entry["spec"], path, digest)  # a draft, then compiled
+            key = self._key(entry) + "|file|" + str(digest) + "|" + stage
+            m, info = self._cached(key, lambda: self.files.build(
+                entry["spec"], path, digest, page_params(entry),
+                lambda kept: entry_spec({**entry, "params": kept})))
+        _check_channels(m)
+        return m, info
+
+    def model_only(self, entry: dict, m, info: dict, mode: str, phi_i: float) -> dict:
+        """Views that depend on the model alone (not on the direction or the light):
+        computed once per model and channel mode, so moving θ_i, φ_i or Φ_L skips them
+        (an anisotropic model's albedo curve is at φ_i: computed once per φ_i)."""
+        phi = 0.0 if m.isotropic else phi_i
+
+        def make():
+            png_h, hd = views.halfdiff(m)
+            return {"albedo": views.albedo_curve(m, mode=mode, phi=phi),
+                    "halfdiff": _b64(png_h), "halfdiff_info": hd}
+        return self._cached(self._key(entry) + "|" + info.get("digest", "") + "|views|" + mode
+                            + ("" if info.get("compiled", True) else "|interpreted")
+                            + ("" if m.isotropic else f"|{phi!r}"), make)
+
+    def model_views(self, entry: dict, s: dict) -> dict:
+        """Every view of one entry for the state *s* (:func:`app.parse_state`), or
+        ``{"spec", "error"}``."""
+        try:
+            m, info = self.get_built(entry)
+            png_s, sph = views.sphere(m, phi_l=s["phi_l"], ambient=s["ambient"])
+            return to_jsonable({
+                **info,
+                "spec": entry.get("spec"), "name": m.name, "params": m.to_dict()["params"],
+                "polar": views.polar(m, s["theta_i"], s["phi_i"], cosine=s["cosine"],
+                                     mode=s["mode"]),
+                "lobe": views.lobe(m, s["theta_i"], s["phi_i"]),
+                "curves": views.curves(m, s["theta_i"], s["phi_i"], cosine=s["cosine"],
+                                       mode=s["mode"]),
+                "sphere": _b64(png_s), "sphere_info": sph,
+                "reciprocal_claim": m.reciprocal,
+                **self.model_only(entry, m, info, s["mode"], s["phi_i"]),
+            })
+        except BrdfkitError as exc:
+            return error_entry(entry, str(exc))
+
+    def model_verdict(self, entry: dict, s: dict) -> dict:
+        """The plausibility verdict of one entry (a direction move asks it again: the
+        albedo engine's cache answers it in milliseconds)."""
+        try:
+            m, _ = self.get_built(entry)
+            return to_jsonable(views.verdict(m, phi=s["phi_i"]))
+        except BrdfkitError as exc:
+            return {"spec": entry.get("spec") if isinstance(entry, dict) else None,
+                    "error": str(exc)}
+
+    def export_binary(self, entry: dict) -> tuple[str, bytes]:
+        """``(file name, bytes)`` of one model on the MERL grid."""
+        m, _ = self.get_built(entry)
+        with tempfile.TemporaryDirectory() as d:
+            path = Path(d) / "model.binary"
+            export_merl(m, path)
+            data = path.read_bytes()
+        name = "".join(c if c.isalnum() or c in "-_." else "_" for c in m.name) + ".binary"
+        return name, data
+
+
+def error_entry(entry, message: str) -> dict:
+    """A model that could not be drawn: ``{"spec", "error"}`` (and ``file``)."""
+    spec = entry.get("spec") if isinstance(entry, dict) else None
+    path = files.spec_file(spec) if isinstance(spec, str) and len(spec) <= 4096 else None
+    return {"spec": spec, "error": message, **({"file": path} if path else {})}
+
+
+class _Marks:
+    """The watcher face a :class:`~brdfkit.explorer.files.FileModels` sees in a worker: the
+    digests come from the web server, a compiled model is reported to it."""
+
+    def __init__(self, session: Session, mark):
+        self._session, self._mark = session, mark
+
+    def mark(self, path: str) -> None:
+        if self._mark is not None:
+            self._mark(path)
+
