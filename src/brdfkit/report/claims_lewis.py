@@ -346,8 +346,9 @@ def _table2_rule(numbers, tol) -> Outcome:
     rows = numbers["rows"]
     bad = [r["row"] for r in rows if not r["agrees"]]
     text = "; ".join(f"{r['row']}: computed energy {r['energy']}, reciprocal "
-                     f"{'yes' if r['reciprocal'] else 'no'} (paper: E {r['paper']['conserves_energy']}"
-                     f", R {r['paper']['reciprocal']})" for r in rows)
+                     f"{'yes' if r['reciprocal'] else 'no'} (paper: E "
+                     f"{r['paper']['conserves_energy']}, R {r['paper']['reciprocal']})"
+                     for r in rows)
     return Outcome("refuted" if bad else "confirmed", text + ".")
 
 

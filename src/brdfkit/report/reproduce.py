@@ -1,0 +1,261 @@
+"""
+``brdfkit reproduce``: every figure, table and claim of the three papers, into one report
+========================================================================================
+
+:func:`reproduce` computes every item of :func:`brdfkit.report.reproduce_items.items`
+(figures, tables, claims), each on its own — in a process pool of *jobs* workers —, and
+writes ``index.html``, ``report.md``, ``claims.json`` and ``figures/*.png`` under the output
+directory (each file atomically). An item that raises is recorded as failed (its one-line
+error) and the run goes on; :class:`Run` says how many failed.
+
+**Cache by content.** An item's result is stored under the cache directory
+(``$BRDFKIT_CACHE_DIR``, else ``$XDG_CACHE_HOME/brdfkit`` or ``~/.cache/brdfkit``,
+sub-directory ``reproduce/``) keyed by the SHA-256 of: every file of the brdfkit package
+(the code version), every file of the fitting-study directory read (the inputs), the
+item and the run's settings (preview or full). A re-run with nothing changed reads every
+item from there; any change of code or data recomputes every item (no guess about which
+items a change touches). Failures are not cached.
+
+**--full.** Fits every MERL material again (:func:`brdfkit.fitting.study.run_study`,
+*jobs* workers, resumable: the batch files are kept under ``OUT/fitting-study/`` and a
+re-run continues them) and renders at paper quality, then reports as above from those
+batches.
+
+Public objects
+--------------
+- :func:`reproduce`, :class:`Run`, :func:`code_version`, :func:`default_study_dir`,
+  :func:`cache_root`.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import hashlib
+import json
+import multiprocessing
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from brdfkit._cache import memo
+from brdfkit.errors import BrdfkitError
+from brdfkit.report.claim_record import Context
+from brdfkit.report.reproduce_items import PAPERS, Item, compute_item, items
+
+__all__ = ["Run", "cache_root", "code_version", "default_study_dir", "reproduce"]
+
+#: Expected seconds of the slow items at preview settings (measured on the 2-core machine),
+#: so the pool starts them first; unlisted items count 1 s.
+_COST = {"figure:neumann-fig8": 25.0, "figure:energy-reciprocity": 12.0,
+         "figure:neumann-fig1": 12.0, "figure:nielsen-fig1": 10.0, "figure:lewis-fig7": 9.0,
+         "claim:lewis-5-reciprocity": 7.0, "table:lewis-table2": 8.0,
+         "claim:neumann-5-controlled-bound": 9.0, "figure:neumann-fig4": 6.0,
+         "figure:neumann-fig3": 6.0, "claim:lewis-table2": 5.0}
+
+
+@dataclass
+class Run:
+    """The outcome of :func:`reproduce`: the results (one dict per item, in the report's
+    order), the files written, and the counts."""
+
+    out: str
+    results: list[dict]
+    files: list[str] = field(default_factory=list)
+    seconds: float = 0.0
+
+    @property
+    def failed(self) -> list[dict]:
+        return [r for r in self.results if r["status"] == "failed"]
+
+    @property
+    def cached(self) -> int:
+        return sum(1 for r in self.results if r.get("cached"))
+
+
+def default_study_dir() -> str:
+    """The shipped batches: ``docs/fitting-study-data`` of the clone brdfkit runs from."""
+    return str(Path(__file__).resolve().parents[3] / "docs" / "fitting-study-data")
+
+
+def cache_root() -> Path:
+    """Where results are cached (module docstring)."""
+    root = os.environ.get("BRDFKIT_CACHE_DIR")
+    if not root:
+        xdg = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+        root = os.path.join(xdg, "brdfkit")
+    return Path(root) / "reproduce"
+
+
+def _hash_tree(root: Path, h) -> None:
+    for path in sorted(p for p in root.rglob("*") if p.is_file()
+                       and "__pycache__" not in p.parts and not p.name.startswith(".")):
+        h.update(str(path.relative_to(root)).encode() + b"\0")
+        h.update(path.read_bytes())
+
+
+@memo(maxsize=1)  # once per process: the package does not change under a running command
+def code_version() -> str:
+    """SHA-256 (16 hex digits) of every file of the brdfkit package: the code version."""
+    h = hashlib.sha256()
+    _hash_tree(Path(__file__).resolve().parents[1], h)
+    return h.hexdigest()[:16]
+
+
+def _inputs_version(study_dir: str) -> str:
+    h = hashlib.sha256(code_version().encode())
+    if os.path.isdir(study_dir):
+        _hash_tree(Path(study_dir), h)
+    return h.hexdigest()
+
+
+def _key(item: Item, inputs: str, full: bool) -> str:
+    return hashlib.sha256(f"{inputs}|{item.key}|full={full}".encode()).hexdigest()[:24]
+
+
+def _load(cache: Path, key: str) -> tuple[dict, bytes | None] | None:
+    meta = cache / f"{key}.json"
+    if not meta.exists():
+        return None
+    try:
+        rec = json.loads(meta.read_text(encoding="utf-8"))
+        png = (cache / f"{key}.png").read_bytes() if rec.get("png") else None
+    except (OSError, ValueError):  # a damaged entry: recompute it
+        return None
+    return rec, png
+
+
+def _store(cache: Path, key: str, rec: dict, png: bytes | None) -> None:
+    from brdfkit import _io
+
+    try:
+        cache.mkdir(parents=True, exist_ok=True)
+        if png is not None:
+            _io.write_atomic(cache / f"{key}.png", lambda fh: fh.write(png), option="cache")
+        text = json.dumps({**rec, "png": png is not None}, ensure_ascii=False)
+        _io.write_atomic(cache / f"{key}.json", lambda fh: fh.write(text.encode("utf-8")),
+                         option="cache")
+    except (OSError, BrdfkitError):  # an unwritable cache costs only time on the next run
+        pass
+
+
+def _work(item: Item, ctx: Context, threads: int | None) -> tuple[dict, bytes | None]:
+    """Compute one item; never raises: a failure is a record with its one-line error."""
+    from brdfkit._threads import numba_threads
+    from brdfkit.cli._group import one_line
+
+    t0 = time.perf_counter()
+    try:
+        if threads is None:
+            payload, png = compute_item(item, ctx)
+        else:
+            with numba_threads(threads):
+                payload, png = compute_item(item, ctx)
+        return {"status": "ok", "payload": payload,
+                "seconds": time.perf_counter() - t0}, png
+    except Exception as exc:  # noqa: BLE001 - any failure of one item is reported, not fatal
+        return {"status": "failed", "error": one_line(f"{type(exc).__name__}: {exc}"),
+                "seconds": time.perf_counter() - t0}, None
+
+
+def _full_study(out: str, *, jobs: int, progress) -> str:
+    """Refit every MERL material into ``OUT/fitting-study`` (resumable); its path."""
+    from brdfkit.fitting.batch import expand_targets
+    from brdfkit.fitting.study import run_study
+
+    directory = os.path.join(out, "fitting-study")
+    ngan = os.environ.get("BRDFKIT_NGAN_CSV") or str(
+        Path(__file__).resolve().parents[4] / "shared" / "data" / "measured"
+        / "merl_fits_lafortune_ngan2005.csv")
+    parts = ("nielsen", "neumann") + (("anchors",) if os.path.exists(ngan) else ())
+
+    def tick(done, total, label):
+        if progress is not None:
+            progress("fitting study", done, total, label or "")
+
+    run_study(directory, materials=expand_targets(["merl:all"]), parts=parts,
+              workers=jobs, ngan_csv=ngan if "anchors" in parts else None, progress=tick)
+    return directory
+
+
+def reproduce(out, *, only: str | None = None, full: bool = False, jobs: int = 1,
+              study_dir: str | None = None, use_cache: bool = True,
+              progress: Callable[[str, int, int, str], None] | None = None) -> Run:
+    """Compute every item and write the report under *out* (module docstring).
+
+    Parameters (keyword-only but *out*)
+    -----------------------------------
+    only : {"lewis", "neumann", "nielsen", "beyond"}, optional
+        One paper's items only.
+    full : bool
+        Refit the fitting study (every MERL material) and render at paper quality.
+    jobs : int
+        Worker processes (≥ 1); 1 computes in this process.
+    study_dir : str, optional
+        The fitting study's batch directory (default: the shipped batches).
+    use_cache : bool
+        Read and write the result cache.
+    progress : callable, optional
+        ``progress(stage, done, total, label)`` after each step.
+    """
+    if only is not None and only not in PAPERS:
+        raise BrdfkitError(f"only must be one of {', '.join(PAPERS)}; got {only!r}")
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise BrdfkitError(f"jobs must be an integer >= 1 (worker processes); got {jobs!r}")
+    out = os.fspath(out)
+    t0 = time.perf_counter()
+    os.makedirs(out, exist_ok=True)
+    if full and study_dir is None:
+        study_dir = _full_study(out, jobs=jobs, progress=progress)
+    ctx = Context(study_dir=study_dir or default_study_dir(), full=full)
+    todo = items(only=only)
+    inputs = _inputs_version(ctx.study_dir)
+    cache = cache_root()
+    results: dict[str, dict] = {}
+    pngs: dict[str, bytes] = {}
+    pending = []
+    for it in todo:
+        hit = _load(cache, _key(it, inputs, full)) if use_cache else None
+        if hit is None:
+            pending.append(it)
+        else:
+            results[it.key] = {**hit[0], "cached": True}
+            if hit[1] is not None:
+                pngs[it.key] = hit[1]
+    done = len(results)
+    if progress is not None:
+        progress("items", done, len(todo), f"{done} from the cache")
+    pending.sort(key=lambda it: -_COST.get(it.key, 1.0))
+
+    def finish(it: Item, rec: dict, png: bytes | None) -> None:
+        nonlocal done
+        results[it.key] = rec
+        if png is not None:
+            pngs[it.key] = png
+        if rec["status"] == "ok" and use_cache:
+            _store(cache, _key(it, inputs, full), rec, png)
+        done += 1
+        if progress is not None:
+            progress("items", done, len(todo), it.key
+                     + (" FAILED" if rec["status"] == "failed" else ""))
+
+    if jobs == 1 or len(pending) <= 1:
+        for it in pending:
+            finish(it, *_work(it, ctx, None))
+    else:
+        spawn = multiprocessing.get_context("spawn")  # no fork of Numba's threads
+        with cf.ProcessPoolExecutor(max_workers=min(jobs, len(pending)),
+                                    mp_context=spawn) as pool:
+            futures = {pool.submit(_work, it, ctx, 1): it for it in pending}
+            for fut in cf.as_completed(futures):
+                finish(futures[fut], *fut.result())
+    ordered = [{"kind": it.kind, "name": it.name, "paper": it.paper, "section": it.section,
+                "title": it.title, **results[it.key]} for it in todo]
+    run = Run(out=out, results=ordered)
+    from brdfkit.report.reproduce_write import write_report
+
+    run.seconds = time.perf_counter() - t0
+    run.files = write_report(run, pngs={f"{r['kind']}:{r['name']}": pngs.get(
+        f"{r['kind']}:{r['name']}") for r in ordered}, ctx=ctx, only=only)
+    return run
