@@ -324,15 +324,14 @@ CLAIMS = (
           "n < 20, below the paper's exponents: confirmed with a correction).",
           _eq22, _eq22_rule, 1e-5, _S5),
     study_claim(id="neumann-1.1-perceptual", paper=PAPER, location="§1.1", section=_S1,
-                match="perceptual fitting",
                 statement="Perceptual fitting (the maximal relative errors of the BRDF × "
                 "cosine and of the albedo minimised together) gives smaller maximal relative "
                 "errors than least squares."),
     study_claim(id="neumann-3-pumped-fit-g1", paper=PAPER, location="§3, §5 (metals)",
-                section=_S3, match="pumped Phong (g₁ = max) fit",
+                section=_S3,
                 statement="Pumping up the albedo (g₁) makes the Phong model fit metals better "
                 "(a better energy mirror at grazing angles)."),
     study_claim(id="neumann-3-pumped-fit-g2", paper=PAPER, location="§3.2, §5 (metals)",
-                section=_S5, match="pumped Phong (g₂ = controlled) fit",
+                section=_S5,
                 statement="Controlled pumping (g₂) makes the Phong model fit metals better."),
 )

@@ -136,19 +136,18 @@ CLAIMS = (
           "the study's L1 fits of Phong and Blinn–Phong (both with Fresnel, η free) to the "
           "MERL surrogate.", _fig1, _fig1_rule("nickel", "Blinn–Phong"), None, _SF),
     study_claim(id="nielsen-both-kinds", paper=PAPER, location="Comparison to measured BRDFs",
-                section=_SF, match="some materials are fitted best",
+                section=_SF,
                 statement="Some materials are fitted best by the Phong variant (1), others by "
                 "the Blinn–Phong variant (2)."),
     study_claim(id="nielsen-alpha-mix-better", paper=PAPER, location="Our Phong model variant",
-                section=_S3, match="fits better to a broader range",
+                section=_S3,
                 statement="The new variant (eq. 3) fits better to a broader range of "
                 "materials."),
     study_claim(id="nielsen-l1-l2", paper=PAPER, location="Fitting results", section=_SF,
-                match="L2 fits the lobe to the tops",
                 statement="L² fits the lobe to the tops of the specular highlights, L¹ roughly "
                 "to their base."),
     study_claim(id="nielsen-robust", paper=PAPER, location="Fitting results, stages (i)–(iii)",
-                section=_SF, match="robust convergence",
+                section=_SF,
                 statement="The three-stage procedure gives robust convergence for all the "
                 "BRDFs measured by Matusik et al."),
 )

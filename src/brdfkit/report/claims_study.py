@@ -18,11 +18,37 @@ import os
 
 from brdfkit.report.claim_record import Claim, Outcome
 
-__all__ = ["STUDY_VERDICT", "read_shipped_study", "study_claim", "study_rows"]
+__all__ = ["STUDY_CLAIMS", "STUDY_VERDICT", "ledger_id", "read_shipped_study", "study_claim",
+           "study_rows"]
 
 #: The study's verdict words → the report's verdicts.
 STUDY_VERDICT = {"supported": "confirmed", "not supported": "refuted",
                  "partly supported": "refuted", "no data": "undetermined"}
+
+
+#: The claims ledger's id of each study verdict → the words its claim (or test) contains.
+STUDY_CLAIMS = {
+    "neumann-1.1-perceptual": "perceptual fitting",
+    "neumann-3-pumped-fit-g1": "pumped Phong (g₁ = max) fit",
+    "neumann-3-pumped-fit-g2": "pumped Phong (g₂ = controlled) fit",
+    "nielsen-both-kinds": "some materials are fitted best",
+    "nielsen-alpha-mix-better": "fits better to a broader range",
+    "nielsen-l1-l2": "L2 fits the lobe to the tops",
+    "nielsen-robust": "robust convergence",
+}
+
+
+def _text(row: dict) -> str:
+    return row["claim"] + " | " + row["test"]
+
+
+def ledger_id(row: dict) -> str:
+    """The ledger's claim id of a study verdict (a row of ``fit_study_verdicts.claims``),
+    or ``""`` when the ledger has none (the Ngan anchors: not a claim of the papers)."""
+    for cid, match in STUDY_CLAIMS.items():
+        if match in _text(row):
+            return cid
+    return ""
 
 
 def read_shipped_study(directory: str) -> dict:
@@ -47,13 +73,14 @@ def study_rows(ctx) -> list[dict]:
     return claims(read_shipped_study(ctx.study_dir))
 
 
-def study_claim(*, id: str, paper: str, location: str, section: str, match: str,
+def study_claim(*, id: str, paper: str, location: str, section: str,
                 statement: str) -> Claim:
-    """A claim record whose numbers are the study verdict whose claim text contains
-    *match* (and whose test names it, for the two pumping claims)."""
+    """A claim record whose numbers are the study verdict :data:`STUDY_CLAIMS` names for
+    *id*."""
+    match = STUDY_CLAIMS[id]
 
     def compute(ctx):
-        rows = [r for r in study_rows(ctx) if match in r["claim"] + " | " + r["test"]]
+        rows = [r for r in study_rows(ctx) if match in _text(r)]
         if not rows:
             return {"study_verdict": "no data", "evidence": "", "test": ""}
         r = rows[0]

@@ -124,13 +124,23 @@ def _header(mats) -> list[str]:
 
 def _claims_section(study, arows) -> list[str]:
     """Every claim, its test and its verdict."""
-    L: list[str] = ["## The claims and the verdicts", ""]
+    from brdfkit.report.claims_study import STUDY_VERDICT, ledger_id
+
+    L: list[str] = ["## The claims and the verdicts", "",
+                    "The *ledger* column is the claim's record in `brdfkit reproduce`'s claims "
+                    "ledger (`brdfkit.report.claims`), which reads these very verdicts: "
+                    "\"partly supported\" is a refuted general claim there.", ""]
     cl = claims(study)
     if arows:
         cl.append(anchor_claim(arows))
-    L += _table(["paper", "claim", "test", "verdict", "evidence"],
-                [(c["paper"], c["claim"], c["test"], f"**{c['verdict']}**", c["evidence"])
-                 for c in cl])
+
+    def ledger(c):
+        cid = ledger_id(c)
+        return f"`{cid}`: {STUDY_VERDICT[c['verdict']]}" if cid else "— (not a paper's claim)"
+
+    L += _table(["paper", "claim", "test", "verdict", "ledger", "evidence"],
+                [(c["paper"], c["claim"], c["test"], f"**{c['verdict']}**", ledger(c),
+                  c["evidence"]) for c in cl])
     L += [""]
     return L
 

@@ -129,11 +129,12 @@ def _html_item(r: dict, pngs: dict) -> str:
     v = p["verdict"]
     corr = (f"<p><strong>Correction:</strong> {_e(p['correction'])}</p>"
             if p["correction"] else "")
-    tol = "" if p["tolerance"] is None else f"; tolerance {p['tolerance']:g}"
+    tol = ("" if p["tolerance"] is None else
+           f' <span class="meta">(tolerance {p["tolerance"]:g})</span>')
     return (f'<article class="claim {_BADGE[v]}" id="{aid}"><h4><a class="self" href="#{aid}">'
             f'#</a> {_e(p["location"])} <span class="badge {_BADGE[v]}">{_e(v)}</span></h4>'
             f'<p><em>The paper:</em> {_e(p["statement"])}</p><p><em>Computed:</em> '
-            f'{_e(p["method"])}{_e(tol)}</p><p><em>Result:</em> {_e(p["reason"])}</p>{corr}'
+            f'{_e(p["method"])}{tol}</p><p><em>Result:</em> {_e(p["reason"])}</p>{corr}'
             f'<details><summary>numbers ({_e(p["id"])}, {r["seconds"]:.1f} s'
             f'{", cached" if r.get("cached") else ""})</summary><pre>'
             f'{_e(json.dumps(p["numbers"], ensure_ascii=False, indent=1))}</pre></details>'
@@ -209,7 +210,7 @@ def _md_item(r: dict) -> list[str]:
                "|" + "---|" * len(p["header"])]
         out += ["| " + " | ".join(_md(c) for c in row) + " |" for row in p["rows"]]
         return out + [""] + [f"- {_md(n)}" for n in p["notes"]] + [""]
-    tol = "" if p["tolerance"] is None else f" Tolerance {p['tolerance']:g}."
+    tol = "" if p["tolerance"] is None else f" (tolerance {p['tolerance']:g})"
     out = [f"#### {p['location']} — **{p['verdict']}** <a id=\"{_anchor('claim', r['name'])}\">"
            "</a>", "", f"- *The paper:* {p['statement']}",
            f"- *Computed:* {p['method']}{tol}", f"- *Result:* {p['reason']}"]
