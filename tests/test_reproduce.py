@@ -235,3 +235,18 @@ def test_page_in_chromium_loads_every_image_and_resolves_every_link(nielsen_repo
     assert page.locator("script").count() == 0
     assert errors == []
     page.close()
+
+
+def test_progress_is_a_bar_with_an_eta_on_a_terminal_and_lines_otherwise(capsys):
+    from brdfkit.cli.reproduce_commands import progress_printer
+
+    bar = progress_printer(interactive=True)
+    for done in range(5):
+        bar("items", done, 4, f"item {done}")
+    err = capsys.readouterr().err
+    assert "\r" in err and "[#######.....................] 1/4" in err
+    assert "ETA" in err and err.endswith("\n")  # the finished bar ends its line
+    lines = progress_printer(interactive=False)
+    lines("items", 1, 2, "figure:x")
+    lines("items", 2, 2, "figure:y")
+    assert capsys.readouterr().err.splitlines()[-1] == "items: 2/2 figure:y"

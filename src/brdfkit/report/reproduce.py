@@ -159,8 +159,9 @@ def _work(item: Item, ctx: Context, threads: int | None) -> tuple[dict, bytes | 
                 "seconds": time.perf_counter() - t0}, None
 
 
-def _full_study(out: str, *, jobs: int, progress) -> str:
-    """Refit every MERL material into ``OUT/fitting-study`` (resumable); its path."""
+def _full_study(out: str, *, jobs: int, progress, materials=("merl:all",)) -> str:
+    """Refit *materials* (every MERL material) into ``OUT/fitting-study`` (resumable);
+    its path."""
     from brdfkit.fitting.batch import expand_targets
     from brdfkit.fitting.study import run_study
 
@@ -174,14 +175,15 @@ def _full_study(out: str, *, jobs: int, progress) -> str:
         if progress is not None:
             progress("fitting study", done, total, label or "")
 
-    run_study(directory, materials=expand_targets(["merl:all"]), parts=parts,
+    run_study(directory, materials=expand_targets(list(materials)), parts=parts,
               workers=jobs, ngan_csv=ngan if "anchors" in parts else None, progress=tick)
     return directory
 
 
 def reproduce(out, *, only: str | None = None, full: bool = False, jobs: int = 1,
               study_dir: str | None = None, use_cache: bool = True,
-              progress: Callable[[str, int, int, str], None] | None = None) -> Run:
+              progress: Callable[[str, int, int, str], None] | None = None,
+              materials: tuple[str, ...] = ("merl:all",)) -> Run:
     """Compute every item and write the report under *out* (module docstring).
 
     Parameters (keyword-only but *out*)
@@ -198,6 +200,9 @@ def reproduce(out, *, only: str | None = None, full: bool = False, jobs: int = 1
         Read and write the result cache.
     progress : callable, optional
         ``progress(stage, done, total, label)`` after each step.
+    materials : tuple of str
+        The materials a full run refits (default every MERL material; a subset for a quick
+        look — the report then describes only those).
     """
     if only is not None and only not in PAPERS:
         raise BrdfkitError(f"only must be one of {', '.join(PAPERS)}; got {only!r}")
@@ -207,7 +212,7 @@ def reproduce(out, *, only: str | None = None, full: bool = False, jobs: int = 1
     t0 = time.perf_counter()
     os.makedirs(out, exist_ok=True)
     if full and study_dir is None:
-        study_dir = _full_study(out, jobs=jobs, progress=progress)
+        study_dir = _full_study(out, jobs=jobs, progress=progress, materials=materials)
     ctx = Context(study_dir=study_dir or default_study_dir(), full=full)
     todo = items(only=only)
     inputs = _inputs_version(ctx.study_dir)
