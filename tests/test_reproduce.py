@@ -81,6 +81,16 @@ def test_claim_lookup_names_the_valid_ids():
     ("nielsen-fig1a-silver-phong", {"materials": {"two-layer-silver": None}, "margin": 0.01},
      "undetermined"),
     ("nielsen-robust", {"study_verdict": "supported", "evidence": "600 of 600"}, "confirmed"),
+    # a Phong shader whose highlight dims with Φ_L too: Lewis's contrast does not hold
+    ("lewis-3.3-dimming-limb", {"phi_l_deg": [0, 30], "models": {
+        "neumann-neumann": {"peak_over_phi0": [1, 0.2], "limb_over_phi0": [0, 0]},
+        "minnaert": {"peak_over_phi0": [1, 0.2], "limb_over_phi0": [0, 0]},
+        "blinn (eq. 8, control)": {"peak_over_phi0": [1, 0.5], "limb_over_phi0": [0, 0]}}},
+     "refuted"),
+    # pumping that darkens the Fig. 8 scene at n = 20
+    ("neumann-4-fig8-brighter", {"size": 8, "spp": 1, "seed": 0,
+                                 "ratio_pumped_over_plain": {"20": 0.99, "5000": 1.7}},
+     "refuted"),
 ])
 def test_a_rule_gives_other_verdicts_on_other_numbers(claim_id, numbers, verdict):
     c = claim(claim_id)

@@ -168,6 +168,91 @@ def _nn_vs_minnaert_rule(numbers, tol) -> Outcome:
     return Outcome("confirmed" if max(d.values()) <= tol else "refuted", text + ".")
 
 
+# ----------------------------------------------------------------- §3.3 dimming, dark limb
+def _spheres(model, phis, size):
+    from brdfkit.render import render_sphere
+
+    out = []
+    for phi in phis:
+        r = render_sphere(model, phi_l=math.radians(phi), size=size)
+        out.append((np.nan_to_num(np.asarray(r.radiance, dtype=float)[..., 0]),
+                    np.asarray(r.mask, dtype=bool)))
+    return out
+
+
+def _limb(img, mask, size) -> float:
+    """Largest radiance in the outermost ring of the sphere (N·V < 0.15)."""
+    y, x = np.mgrid[0:size, 0:size]
+    c = (size - 1) / 2.0
+    rr = np.hypot(x - c, y - c) / (size / 2.0)
+    ring = mask & (rr > math.sqrt(1.0 - 0.15 ** 2))
+    return float(np.max(img[ring])) if np.any(ring) else 0.0
+
+
+def _dimming(ctx):
+    import brdfkit
+
+    size, phis = 96, (0.0, 30.0, 60.0)
+    beta = math.radians(15.0)
+    models = {"neumann-neumann": brdfkit.model("neumann-neumann", b_N=1.0, beta=beta),
+              "minnaert": brdfkit.model("minnaert", b_M=1.0, beta=beta),
+              "blinn (eq. 8, control)": brdfkit.model("blinn", k_d=0.0, k_s=1.0, beta=beta)}
+    out = {}
+    for name, m in models.items():
+        imgs = _spheres(m, phis, size)
+        peak0 = max(float(np.max(imgs[0][0])), 1e-300)
+        out[name] = {"peak_over_phi0": [float(np.max(i)) / peak0 for i, _ in imgs],
+                     "limb_over_phi0": [_limb(i, k, size) / peak0 for i, k in imgs]}
+    return {"phi_l_deg": list(phis), "beta_deg": 15.0, "size": size, "models": out}
+
+
+def _dimming_rule(numbers, tol) -> Outcome:
+    d = numbers["models"]
+    sep = [d[k] for k in ("neumann-neumann", "minnaert")]
+    dims = all(all(b < a for a, b in zip(v["peak_over_phi0"], v["peak_over_phi0"][1:],
+                                         strict=False)) for v in sep)
+    dark = all(max(v["limb_over_phi0"]) <= tol for v in sep)
+    ctrl = d["blinn (eq. 8, control)"]["peak_over_phi0"]
+    phong_keeps = min(ctrl) >= 1.0 - tol  # "unlike Phong shaders"
+    text = ("peak radiance ÷ its Φ_L = 0 value at Φ_L = " + ", ".join(
+        f"{p:g}°" for p in numbers["phi_l_deg"]) + ": " + "; ".join(
+        f"{k}: " + ", ".join(f"{x:.3f}" for x in v["peak_over_phi0"])
+        + f" (limb ≤ {max(v['limb_over_phi0']):.1e})" for k, v in d.items()))
+    ok = dims and dark and phong_keeps
+    return Outcome("confirmed" if ok else "refuted", text + f" (rule: decreasing, limb ≤ "
+                   f"{tol:g} of the peak; the Phong shader's peak does not decrease).")
+
+
+# ----------------------------------------------------------------- §6 eq. (24) dimmer
+def _eq24_dimmer(ctx):
+    import brdfkit
+
+    size, phis = 96, (0.0, 60.0, 90.0, 120.0)
+    out = {}
+    for bd in BETAS:
+        b = math.radians(bd)
+        pairs = {"eq. 8 (Fig. 3)": brdfkit.model("blinn", k_d=0.5, k_s=0.5, beta=b),
+                 "eq. 24 (Fig. 10)": brdfkit.model("phong-blinn-reciprocal", k_d=0.5,
+                                                   k_s=0.5, beta=b)}
+        peaks = {k: [float(np.max(i)) for i, _ in _spheres(m, phis, size)]
+                 for k, m in pairs.items()}
+        out[f"{bd:g}"] = [a / c for a, c in zip(peaks["eq. 24 (Fig. 10)"],
+                                                peaks["eq. 8 (Fig. 3)"], strict=True)]
+    return {"phi_l_deg": list(phis), "k_s": 0.5, "size": size,
+            "peak_radiance_ratio_eq24_over_eq8": out}
+
+
+def _eq24_dimmer_rule(numbers, tol) -> Outcome:
+    d = numbers["peak_radiance_ratio_eq24_over_eq8"]
+    large = [v[i] for v in d.values() for i, p in enumerate(numbers["phi_l_deg"]) if p >= 90]
+    ok = max(large) < 1.0 - tol
+    return Outcome("confirmed" if ok else "refuted",
+                   "peak (highlight) radiance of eq. (24) ÷ eq. (8) (k_d = k_s = 0.5) at Φ_L = "
+                   + ", ".join(f"{p:g}°" for p in numbers["phi_l_deg"]) + ": " + "; ".join(
+                       f"β = {b}°: " + ", ".join(f"{x:.3f}" for x in v) for b, v in d.items())
+                   + f" (rule: < 1 − {tol:g} at Φ_L ≥ 90°).")
+
+
 # ----------------------------------------------------------------- §4.1 eq. (19)
 def _phong_diverges(ctx):
     from brdfkit.analysis import H_s
@@ -389,6 +474,13 @@ CLAIMS = (
           "both rendered exactly on the test configuration (b_N = b_M = 1, same β, Φ_L = 0, "
           "30, 60°); largest |L_NN − L_M| relative to the Φ_L = 0 peak (one exposure, as "
           "the figure); rule: ≤ tol.", _nn_vs_minnaert, _nn_vs_minnaert_rule, 0.02, _S3),
+    Claim("lewis-3.3-dimming-limb", PAPER, "§3.3, Fig. 4",
+          "For Neumann–Neumann (and Minnaert) shaders the image radiance decreases as Φ_L "
+          "increases, unlike Phong shaders; the limb of the sphere (N·V = 0) is always dark.",
+          "exact sphere renders (96 px, β = 15°, b = 1) at Φ_L = 0, 30, 60°: the peak ÷ its "
+          "Φ_L = 0 value, and the largest radiance where N·V < 0.15 ÷ that peak; the Phong "
+          "shader with F_s^B (eq. 8) as the contrast; rule: decreasing, limb ≤ tol.",
+          _dimming, _dimming_rule, 0.01, _S3),
     Claim("lewis-4-eq16", PAPER, "§4.1, eq. (16)",
           "∫_Ω (N·V)^γ dω = 2π/(γ + 1).",
           "adaptive quadrature (SciPy quad) of 2π∫cos^γ θ sin θ dθ for γ = 0, 1, 20, 151; "
@@ -424,6 +516,13 @@ CLAIMS = (
           "k_d conserves energy.",
           "albedo engine of k_s (N·H)^n up to θ_i = 89.99° for β = 5°, 15°, 30°; rule: "
           "k_ρ(89.99°)/k_ρ(89°) ≤ 1 + tol.", _eq24, _eq24_rule, 0.05, _S6),
+    Claim("lewis-6-eq24-dimmer", PAPER, "§6, Fig. 10",
+          "While resembling Fig. 3, the images of the reciprocal shader (eq. 24) for large Φ_L "
+          "are dimmer (no (N·S) in the specular denominator).",
+          "exact sphere renders (96 px, k_d = k_s = 0.5, β = 5°, 15°, 30°) of eq. (24) and "
+          "eq. (8) with F_s^B at Φ_L = 0, 60, 90, 120°: ratio of the peak (highlight) "
+          "radiance; rule: "
+          "< 1 − tol at Φ_L ≥ 90°.", _eq24_dimmer, _eq24_dimmer_rule, 0.05, _S6),
     Claim("lewis-table2", PAPER, "§7, Table 2",
           "Conserves energy / reciprocal: Phong no/no; energy-conserving Phong yes/no; "
           "Torrance–Sparrow, Neumann–Neumann, Minnaert, reciprocal Phong–Blinn yes/yes "

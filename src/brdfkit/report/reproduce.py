@@ -52,7 +52,8 @@ _COST = {"figure:neumann-fig8": 25.0, "figure:energy-reciprocity": 12.0,
          "figure:neumann-fig1": 12.0, "figure:nielsen-fig1": 10.0, "figure:lewis-fig7": 9.0,
          "claim:lewis-5-reciprocity": 7.0, "table:lewis-table2": 8.0,
          "claim:neumann-5-controlled-bound": 9.0, "figure:neumann-fig4": 6.0,
-         "figure:neumann-fig3": 6.0, "claim:lewis-table2": 5.0}
+         "figure:neumann-fig3": 6.0, "claim:lewis-table2": 5.0,
+         "claim:neumann-4-fig8-brighter": 15.0, "claim:neumann-3.1-super-metal": 5.0}
 
 
 @dataclass
