@@ -29,7 +29,6 @@ Public objects
 
 from __future__ import annotations
 
-import concurrent.futures as cf
 import hashlib
 import json
 import multiprocessing
@@ -160,6 +159,12 @@ def _work(item: Item, ctx: Context, threads: int | None) -> tuple[dict, bytes | 
                 "seconds": time.perf_counter() - t0}, None
 
 
+def _work_item(args) -> tuple[Item, tuple[dict, bytes | None]]:
+    """:func:`_work` of one ``(item, ctx)`` in a pool worker (one Numba thread each)."""
+    it, ctx = args
+    return it, _work(it, ctx, 1)
+
+
 def _full_study(out: str, *, jobs: int, progress, materials=("merl:all",)) -> str:
     """Refit *materials* (every MERL material) into ``OUT/fitting-study`` (resumable);
     its path."""
@@ -251,11 +256,11 @@ def reproduce(out, *, only: str | None = None, full: bool = False, jobs: int = 1
             finish(it, *_work(it, ctx, None))
     else:
         spawn = multiprocessing.get_context("spawn")  # no fork of Numba's threads
-        with cf.ProcessPoolExecutor(max_workers=min(jobs, len(pending)),
-                                    mp_context=spawn) as pool:
-            futures = {pool.submit(_work, it, ctx, 1): it for it in pending}
-            for fut in cf.as_completed(futures):
-                finish(futures[fut], *fut.result())
+        # leaving the block terminates the workers: on Ctrl-C or SIGTERM (SystemExit) at
+        # once, nothing more is computed; what finished is cached, so a re-run resumes
+        with spawn.Pool(processes=min(jobs, len(pending))) as pool:
+            for it, (rec, png) in pool.imap_unordered(_work_item, [(it, ctx) for it in pending]):
+                finish(it, rec, png)
     ordered = [{"kind": it.kind, "name": it.name, "paper": it.paper, "section": it.section,
                 "title": it.title, **results[it.key]} for it in todo]
     run = Run(out=out, results=ordered)
