@@ -261,6 +261,8 @@ def reproduce(out, *, only: str | None = None, full: bool = False, jobs: int = 1
         with spawn.Pool(processes=min(jobs, len(pending))) as pool:
             for it, (rec, png) in pool.imap_unordered(_work_item, [(it, ctx) for it in pending]):
                 finish(it, rec, png)
+            pool.close()  # done: let the workers exit normally (their finalizers run)
+            pool.join()
     ordered = [{"kind": it.kind, "name": it.name, "paper": it.paper, "section": it.section,
                 "title": it.title, **results[it.key]} for it in todo]
     run = Run(out=out, results=ordered)
