@@ -169,20 +169,31 @@ def _full_study(out: str, *, jobs: int, progress, materials=("merl:all",)) -> st
     """Refit *materials* (every MERL material) into ``OUT/fitting-study`` (resumable);
     its path."""
     from brdfkit.fitting.batch import expand_targets
-    from brdfkit.fitting.study import run_study
+    from brdfkit.fitting.study import read_ngan_table, run_study, study_batches
 
     directory = os.path.join(out, "fitting-study")
     ngan = os.environ.get("BRDFKIT_NGAN_CSV") or str(
         Path(__file__).resolve().parents[4] / "shared" / "data" / "measured"
         / "merl_fits_lafortune_ngan2005.csv")
     parts = ("nielsen", "neumann") + (("anchors",) if os.path.exists(ngan) else ())
+    targets = expand_targets(list(materials))
+    names = read_ngan_table(ngan) if "anchors" in parts else None
+    # one bar over the whole study: every batch's fits and as many derived rows
+    grand = sum(2 * len(b.targets) for b in study_batches(targets, parts=parts,
+                                                          ngan_names=names))
+    state = {"offset": 0, "batch": 0}
 
     def tick(done, total, label):
+        if not label:  # a batch (of fits or of derived rows) starts: nothing new to show
+            state["offset"] += state["batch"]
+            state["batch"] = total
+            if state["offset"] + done > 0:
+                return
         if progress is not None:
-            progress("fitting study", done, total, label or "")
+            progress("fitting study", min(state["offset"] + done, grand), grand, label or "")
 
-    run_study(directory, materials=expand_targets(list(materials)), parts=parts,
-              workers=jobs, ngan_csv=ngan if "anchors" in parts else None, progress=tick)
+    run_study(directory, materials=targets, parts=parts, workers=jobs,
+              ngan_csv=ngan if "anchors" in parts else None, progress=tick)
     return directory
 
 
@@ -199,7 +210,9 @@ def reproduce(out, *, only: str | None = None, full: bool = False, jobs: int = 1
     full : bool
         Refit the fitting study (every MERL material) and render at paper quality.
     jobs : int
-        Worker processes (≥ 1); 1 computes in this process.
+        Worker processes (≥ 1); 1 computes in this process. The workers are *spawned*
+        (no fork of Numba's threads), so a script calling this with ``jobs > 1`` needs the
+        ``if __name__ == "__main__":`` guard, as any spawn-based multiprocessing does.
     study_dir : str, optional
         The fitting study's batch directory (default: the shipped batches).
     use_cache : bool
