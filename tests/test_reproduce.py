@@ -261,3 +261,18 @@ def test_progress_is_a_bar_with_an_eta_on_a_terminal_and_lines_otherwise(capsys)
     lines("items", 1, 2, "figure:x")
     lines("items", 2, 2, "figure:y")
     assert capsys.readouterr().err.splitlines()[-1] == "items: 2/2 figure:y"
+
+
+def test_the_cache_keeps_the_most_recent_versions_only(tmp_path):
+    import os
+
+    from brdfkit.report.reproduce import KEEP_VERSIONS, _prune
+
+    for i in range(6):  # six old versions, the oldest first
+        d = tmp_path / f"old{i}"
+        d.mkdir()
+        (d / "x.json").write_text("{}")
+        os.utime(d, (1000.0 + i, 1000.0 + i))
+    _prune(tmp_path / "now")
+    kept = sorted(p.name for p in tmp_path.iterdir())
+    assert kept == sorted(["now", *[f"old{i}" for i in range(6 - KEEP_VERSIONS + 1, 6)]])

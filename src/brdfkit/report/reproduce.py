@@ -14,7 +14,8 @@ sub-directory ``reproduce/``) keyed by the SHA-256 of: every file of the brdfkit
 (the code version), every file of the fitting-study directory read (the inputs), the
 item and the run's settings (preview or full). A re-run with nothing changed reads every
 item from there; any change of code or data recomputes every item (no guess about which
-items a change touches). Failures are not cached.
+items a change touches). Failures are not cached. Each version of code and inputs has its
+own directory; the :data:`KEEP_VERSIONS` most recently used are kept, older ones removed.
 
 **--full.** Fits every MERL material again (:func:`brdfkit.fitting.study.run_study`,
 *jobs* workers, resumable: the batch files are kept under ``OUT/fitting-study/`` and a
@@ -140,6 +141,27 @@ def _store(cache: Path, key: str, rec: dict, png: bytes | None) -> None:
         pass
 
 
+#: Versions (of code and inputs) whose results are kept: this one and the last few, so
+#: switching between branches does not recompute, while old versions do not pile up
+#: (~5 MB each, mostly figures).
+KEEP_VERSIONS = 4
+
+
+def _prune(current: Path) -> None:
+    """Remove all but the :data:`KEEP_VERSIONS` most recently used version directories."""
+    import shutil
+
+    try:
+        current.mkdir(parents=True, exist_ok=True)
+        os.utime(current)  # mark as used now
+        versions = sorted((p for p in current.parent.iterdir() if p.is_dir()),
+                          key=lambda p: p.stat().st_mtime, reverse=True)
+    except OSError:  # an unwritable cache costs only time
+        return
+    for old in versions[KEEP_VERSIONS:]:
+        shutil.rmtree(old, ignore_errors=True)
+
+
 def _work(item: Item, ctx: Context, threads: int | None) -> tuple[dict, bytes | None]:
     """Compute one item; never raises: a failure is a record with its one-line error."""
     from brdfkit._threads import numba_threads
@@ -235,7 +257,9 @@ def reproduce(out, *, only: str | None = None, full: bool = False, jobs: int = 1
     ctx = Context(study_dir=study_dir or default_study_dir(), full=full)
     todo = items(only=only)
     inputs = _inputs_version(ctx.study_dir)
-    cache = cache_root()
+    cache = cache_root() / inputs[:16]  # one directory per code and input version
+    if use_cache:
+        _prune(cache)
     results: dict[str, dict] = {}
     pngs: dict[str, bytes] = {}
     pending = []
