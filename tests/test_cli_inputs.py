@@ -446,7 +446,7 @@ def test_cli_command_modules_do_not_import_the_cli_package():
     ctx = click.Context(main)
     assert set(main.list_commands(ctx)) == {"models", "eval", "albedo", "check", "table2",
                                             "figure", "render", "materials", "export",
-                                            "explore", "fit", "verdicts"}
+                                            "explore", "fit", "verdicts", "reproduce"}
     assert set(main.get_command(ctx, "render").commands) == {"sphere"}
 
 

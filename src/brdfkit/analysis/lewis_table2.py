@@ -38,7 +38,7 @@ from brdfkit.models import BRDF, MODELS, resolve
 from brdfkit.models import model as registered_model
 
 __all__ = ["LEWIS_ROWS", "NEUMANN_CLAIMS", "EXTRA_ROWS", "table2", "format_table",
-           "format_markdown"]
+           "format_markdown", "table_cells"]
 
 # (shader class as printed in Table 2, model, energy claim, reciprocal claim, objection)
 LEWIS_ROWS = (
@@ -226,6 +226,14 @@ def _cells(r: dict) -> list[str]:
 
 
 HEADER = ["model", "reciprocal", "asym", "energy", "max a @ deg", "paper", "agrees"]
+
+
+def table_cells(rows: list[dict]) -> tuple[list[str], list[list[str]], list[str]]:
+    """The table as text cells: ``(header, cells per row, notes)`` (each note prefixed by
+    its row), the one layout :func:`format_table`, :func:`format_markdown` and the
+    report of ``brdfkit reproduce`` print."""
+    return (list(HEADER), [_cells(r) for r in rows],
+            [f"{r['row']}: {n}" for r in rows for n in r["notes"]])
 
 
 def format_table(rows: list[dict]) -> str:

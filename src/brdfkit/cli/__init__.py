@@ -20,6 +20,7 @@ the command modules import :mod:`brdfkit.cli._common` and never this module.
 - :mod:`brdfkit.cli.explore_commands` — ``explore`` (the browser app).
 - :mod:`brdfkit.cli.render_commands` — ``render sphere``.
 - :mod:`brdfkit.cli.fit_commands` — ``fit``.
+- :mod:`brdfkit.cli.reproduce_commands` — ``reproduce`` (the papers' report).
 - :mod:`brdfkit.cli._group` — the group class (one-line errors, SIGTERM).
 - :mod:`brdfkit.cli._common` — model options, directions, JSON.
 - :mod:`brdfkit.cli._progress` — progress on stderr.
@@ -63,6 +64,7 @@ _COMMANDS = {
     "explore": "brdfkit.cli.explore_commands:explore_cmd",
     "render": "brdfkit.cli.render_commands:render_group",
     "fit": "brdfkit.cli.fit_commands:fit_cmd",
+    "reproduce": "brdfkit.cli.reproduce_commands:reproduce_cmd",
 }
 
 

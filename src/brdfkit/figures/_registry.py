@@ -49,6 +49,7 @@ FIGURES: Mapping[str, Callable] = MappingProxyType({
 #: --seed); figures not listed take none.
 FIGURE_OPTIONS: Mapping[str, tuple[str, ...]] = MappingProxyType({
     "neumann-fig8": ("spp", "size", "seed"),
+    "nielsen-fig1": ("size",),
 })
 
 #: name → function of the models to draw (``f(*models)`` → Figure): figures of any model or

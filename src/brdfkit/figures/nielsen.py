@@ -45,28 +45,49 @@ FITS = (("α-mix (eq. 3)", {}), ("Phong (α = 0)", {"alpha": 0.0}),
         ("Blinn–Phong (α = 1)", {"alpha": 1.0}))
 
 
-def _render(m) -> np.ndarray:
+def _render(m, size: int = SIZE) -> np.ndarray:
     out = 0.0
     for phi, az in LIGHTS:
         out = out + render_sphere(m, phi_l=math.radians(phi), light_azimuth=math.radians(az),
-                                  size=SIZE).radiance
+                                  size=size).radiance
     return np.nan_to_num(np.asarray(out, dtype=np.float64), nan=0.0)
 
 
-def nielsen_fig1():
-    """4 materials × (measured, α-mix, Phong, Blinn–Phong), two lights, L1 fits."""
+def _fitted(name: str, label: str, fixed: dict, target, fits):
+    """(model, L1) of one panel: from *fits* (already fitted: ``fits[name][label] =
+    (params, L1)``, e.g. the fitting study's rows) when it has the panel, else fitted now."""
+    if fits is not None and label in fits.get(name, {}):
+        params, value = fits[name][label]
+        return brdfkit.model("nielsen", **params), float(value)
+    res = fit(brdfkit.model("nielsen", eta=ETA0, **fixed), target, loss="l1",
+              procedure="nielsen", fixed=fixed or None)
+    return res.model, float(res.value)
+
+
+def nielsen_fig1(*, size: int = SIZE, fits: dict | None = None):
+    """4 materials × (measured, α-mix, Phong, Blinn–Phong), two lights, L1 fits.
+
+    *size*: side of each sphere in pixels. *fits*: fits made before (material name →
+    {panel label of :data:`FITS` → (parameters of model ``nielsen``, L1)}), used instead of
+    fitting again where given (``brdfkit reproduce`` passes the fitting study's).
+    """
     import matplotlib.pyplot as plt
+
+    from brdfkit.errors import ParameterError
+
+    if not isinstance(size, int) or isinstance(size, bool) or not 16 <= size <= 2048:
+        raise ParameterError(f"nielsen-fig1: size must be an integer in [16, 2048] (pixels); "
+                             f"got {size!r}")
 
     cols = 1 + len(FITS)
     fig, axes = plt.subplots(len(MATERIALS), cols, figsize=(2.3 * cols, 2.5 * len(MATERIALS)),
                              squeeze=False)
     for r, name in enumerate(MATERIALS):
         target = brdfkit.model(f"merl:{name}")
-        images = [(f"merl:{name}\n(NBRDF surrogate)", _render(target))]
+        images = [(f"merl:{name}\n(NBRDF surrogate)", _render(target, size))]
         for label, fixed in FITS:
-            res = fit(brdfkit.model("nielsen", eta=ETA0, **fixed), target, loss="l1",
-                      procedure="nielsen", fixed=fixed or None)
-            images.append((f"{label}\nL1 = {res.value:.3g}", _render(res.model)))
+            model, value = _fitted(name, label, fixed, target, fits)
+            images.append((f"{label}\nL1 = {value:.3g}", _render(model, size)))
         exposure = 1.0 / max(float(np.max(images[0][1])), 1e-300)
         for c, (label, rad) in enumerate(images):
             ax = axes[r, c]

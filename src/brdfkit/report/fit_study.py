@@ -45,7 +45,8 @@ from brdfkit.report.fit_study_verdicts import (
     nielsen_table,
 )
 
-__all__ = ["write_report", "claims", "nielsen_table", "FULL_MATERIALS"]
+__all__ = ["write_report", "claims", "nielsen_table", "FULL_MATERIALS", "nielsen_rows",
+           "neumann_rows", "anchor_rows", "plausibility_rows"]
 
 #: Materials of the full study (every MERL material).
 FULL_MATERIALS = 100
@@ -123,15 +124,40 @@ def _header(mats) -> list[str]:
 
 def _claims_section(study, arows) -> list[str]:
     """Every claim, its test and its verdict."""
-    L: list[str] = ["## The claims and the verdicts", ""]
+    from brdfkit.report.claims_study import STUDY_VERDICT, ledger_id
+
+    L: list[str] = ["## The claims and the verdicts", "",
+                    "The *ledger* column is the claim's record in `brdfkit reproduce`'s claims "
+                    "ledger (`brdfkit.report.claims`), which reads these very verdicts: "
+                    "\"partly supported\" is a refuted general claim there.", ""]
     cl = claims(study)
     if arows:
         cl.append(anchor_claim(arows))
-    L += _table(["paper", "claim", "test", "verdict", "evidence"],
-                [(c["paper"], c["claim"], c["test"], f"**{c['verdict']}**", c["evidence"])
-                 for c in cl])
+
+    def ledger(c):
+        cid = ledger_id(c)
+        return f"`{cid}`: {STUDY_VERDICT[c['verdict']]}" if cid else "— (not a paper's claim)"
+
+    L += _table(["paper", "claim", "test", "verdict", "ledger", "evidence"],
+                [(c["paper"], c["claim"], c["test"], f"**{c['verdict']}**", ledger(c),
+                  c["evidence"]) for c in cl])
     L += [""]
     return L
+
+
+def nielsen_rows(study, *, bold: str = "") -> tuple[list[str], list[list[str]]]:
+    """Nielsen's three variants per material: (header, text cells); the lowest L1 of a
+    row between *bold* marks."""
+    t2 = {r["target"]: r for r in nielsen_table(study, "l2")}
+    rows = []
+    for r in nielsen_table(study, "l1"):
+        cells = [(_num(r[v]) if v != r["best"] else f"{bold}{_num(r[v])}{bold}")
+                 for v in NIELSEN_VARIANTS]
+        rows.append([_name(r["target"]), *cells, r["kind"], _num(100 * r["gain"], ".2f"),
+                     _num(r["alpha"], ".3f"),
+                     _num(t2.get(r["target"], {}).get("alpha", math.nan), ".3f")])
+    return (["material", "L1 Phong", "L1 Blinn–Phong", "L1 α-mix",
+             "Phong vs Blinn–Phong (> 1 %)", "α-mix gain (%)", "α (L1)", "α (L2)"], rows)
 
 
 def _nielsen_section(study, figures, rel) -> list[str]:
@@ -144,17 +170,7 @@ def _nielsen_section(study, figures, rel) -> list[str]:
           "", "All three are `nielsen` (eq. 3) with Fresnel (η fitted per channel from "
           "1.5): Phong holds α = 0, Blinn–Phong α = 1. Procedure `nielsen` (stages i–iii)."
           " Lowest L1 per material in bold.", ""]
-    t2 = {r["target"]: r for r in nielsen_table(study, "l2")}
-    rows = []
-    for r in t1:
-        cells = [(_num(r[v]) if v != r["best"] else f"**{_num(r[v])}**")
-                 for v in NIELSEN_VARIANTS]
-        rows.append([_name(r["target"]), *cells, r["kind"], _num(100 * r["gain"], ".2f"),
-                     _num(r["alpha"], ".3f"),
-                     _num(t2.get(r["target"], {}).get("alpha", math.nan), ".3f")])
-    L += _table(["material", "L1 Phong", "L1 Blinn–Phong", "L1 α-mix",
-                 "Phong vs Blinn–Phong (> 1 %)", "α-mix gain (%)", "α (L1)", "α (L2)"],
-                rows)
+    L += _table(*nielsen_rows(study, bold="**"))
     cnt = Counter(r["best"] for r in t1 if r["best"])
     kinds = Counter(r["kind"] for r in t1)
     L += ["", "Lowest L1 per material: " + ", ".join(
@@ -191,6 +207,24 @@ def _nielsen_section(study, figures, rel) -> list[str]:
     return L
 
 
+def neumann_rows(study) -> tuple[list[str], list[list[str]]]:
+    """Neumann's fits per metal, model and loss: (header, text cells)."""
+    rows = []
+    for model, label in NEUMANN_MODELS:
+        for loss in ("perceptual", "l2"):
+            for t, r in sorted(_by_target(study.get(("neumann", f"{model}-{loss}"),
+                                                    [])).items()):
+                d = r.get("derived") or {}
+                rows.append([_name(t), label,
+                             loss, _num(_f(d.get("e_point")), ".3f"),
+                             _num(_f(d.get("e_albedo")), ".3f"),
+                             _num(_f(r.get("metric_perceptual")), ".4g"),
+                             _num(_f(r.get("metric_l2")), ".4g")])
+    rows.sort(key=lambda c: (c[0], c[1], c[2]))
+    return (["metal", "model", "fitted with", "e_point", "e_albedo", "perceptual", "l2"],
+            rows)
+
+
 def _neumann_section(study, figures, rel) -> list[str]:
     """Neumann's perceptual vs L2 fits of the metals, pumped vs plain."""
     neu = [(k, rows) for k, rows in study.items() if k[0] == "neumann"]
@@ -207,20 +241,7 @@ def _neumann_section(study, figures, rel) -> list[str]:
           "incidence is 1 whatever ρ_d, ρ_s are (f/g₁ does not see their common scale; "
           "the fit holds it), so it cannot match a metal's level; with the controlled "
           "g₂ = max(a(L), a(V), N·L, N·V) (eq. 21) the scale is kept. Both are fitted.", ""]
-    rows = []
-    for model, label in NEUMANN_MODELS:
-        for loss in ("perceptual", "l2"):
-            for t, r in sorted(_by_target(study.get(("neumann", f"{model}-{loss}"),
-                                                    [])).items()):
-                d = r.get("derived") or {}
-                rows.append([_name(t), label,
-                             loss, _num(_f(d.get("e_point")), ".3f"),
-                             _num(_f(d.get("e_albedo")), ".3f"),
-                             _num(_f(r.get("metric_perceptual")), ".4g"),
-                             _num(_f(r.get("metric_l2")), ".4g")])
-    rows.sort(key=lambda c: (c[0], c[1], c[2]))
-    L += _table(["metal", "model", "fitted with", "e_point", "e_albedo", "perceptual",
-                 "l2"], rows)
+    L += _table(*neumann_rows(study))
     p = neumann_figure(study, os.path.join(figures, "neumann-errors.png"))
     if p:
         L += ["", f"![perceptual vs L2 errors]({rel}/{os.path.basename(p)})"]
@@ -234,6 +255,19 @@ def _neumann_section(study, figures, rel) -> list[str]:
               "for it — the perceptual fit's albedo error can then exceed the L2 fit's."]
     L += [""]
     return L
+
+
+def _anchor_cells(arows) -> tuple[list[str], list[list[str]]]:
+    return (["material", "ours", "theirs", "ratio",
+             *[f"theirs ({c})" for c in NGAN_CONVENTIONS]],
+            [[_name(r["target"]), _num(_f(r["ours"])), _num(_f(r["theirs"])),
+              _num(_f(r["ratio"]), ".3f"),
+              *[_num(_f(r[f"theirs_{c}"])) for c in NGAN_CONVENTIONS]] for r in arows])
+
+
+def anchor_rows(directory) -> tuple[list[str], list[list[str]]]:
+    """Our Lafortune fits vs Ngan et al.'s, from the study *directory*: (header, cells)."""
+    return _anchor_cells(_anchor_rows(directory))
 
 
 def _anchor_section(arows) -> list[str]:
@@ -251,25 +285,15 @@ def _anchor_section(arows) -> list[str]:
          "reading used is the one "
          f"with the smallest median metric over these materials (most favourable to "
          f"their parameters): **{conv}**. Ratio ≤ 1: ours at least as good.", ""]
-    L += _table(["material", "ours", "theirs", "ratio",
-                 *[f"theirs ({c})" for c in NGAN_CONVENTIONS]],
-                [[_name(r["target"]), _num(_f(r["ours"])), _num(_f(r["theirs"])),
-                  _num(_f(r["ratio"]), ".3f"),
-                  *[_num(_f(r[f"theirs_{c}"])) for c in NGAN_CONVENTIONS]]
-                 for r in arows])
+    L += _table(*_anchor_cells(arows))
     good = sum(_f(r["ratio"]) <= 1.0 for r in arows)
     L += ["", f"Ours at least as good on {good} of {len(arows)} materials "
           f"({'every one' if good == len(arows) else 'not every one'}).", ""]
     return L
 
 
-def _plausibility_section(study) -> list[str]:
-    """Energy verdicts, parameters at a bound, statuses."""
-    L = ["## Plausibility of the fitted models and convergence", "",
-         "Every fitted model through `brdfkit check` (`brdfkit.analysis.plausibility.check`, "
-         "albedo tolerance 1e-5): energy verdict; *at a bound*: a fitted parameter at a bound "
-         "of its declared range; status: the fit's own (0 converged, 1 converged at a bound, "
-         "2 evaluation limit, 3 non-finite).", ""]
+def plausibility_rows(study) -> tuple[list[str], list[list]]:
+    """Energy verdicts, parameters at a bound and statuses per batch: (header, cells)."""
     rows = []
     for (part, name), rr in sorted(study.items()):
         fits = [r for r in rr if _ok(r)]
@@ -281,8 +305,18 @@ def _plausibility_section(study) -> list[str]:
                      energy.get("undetermined", 0) + energy.get("not derived", 0), at_b,
                      " ".join(f"{k}:{status.get(k, 0)}" for k in (0, 1, 2, 3)),
                      len(rr) - len(fits)])
-    L += _table(["batch", "fits", "conserves", "exceeds", "diverges", "undetermined / not "
-                 "derived", "at a bound", "status 0:1:2:3", "errors"], rows)
+    return (["batch", "fits", "conserves", "exceeds", "diverges", "undetermined / not "
+             "derived", "at a bound", "status 0:1:2:3", "errors"], rows)
+
+
+def _plausibility_section(study) -> list[str]:
+    """Energy verdicts, parameters at a bound, statuses."""
+    L = ["## Plausibility of the fitted models and convergence", "",
+         "Every fitted model through `brdfkit check` (`brdfkit.analysis.plausibility.check`, "
+         "albedo tolerance 1e-5): energy verdict; *at a bound*: a fitted parameter at a bound "
+         "of its declared range; status: the fit's own (0 converged, 1 converged at a bound, "
+         "2 evaluation limit, 3 non-finite).", ""]
+    L += _table(*plausibility_rows(study))
     L += [""]
     return L
 
