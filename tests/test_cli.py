@@ -27,8 +27,9 @@ def run(*args: str):
     return CliRunner().invoke(main, list(args))
 
 
-def assert_one_line_error(result, *fragments: str) -> None:
-    """Exit status 2, exactly one line on stderr starting 'brdfkit: error:', no traceback."""
+def assert_one_line_error(result, *fragments: str) -> str:
+    """Exit status 2, exactly one line on stderr starting 'brdfkit: error:', no traceback;
+    returns that line."""
     assert result.exit_code == 2, (result.exit_code, result.output, result.stderr)
     err = result.stderr.strip().splitlines()
     assert len(err) == 1, result.stderr
@@ -37,6 +38,7 @@ def assert_one_line_error(result, *fragments: str) -> None:
     assert result.exception is None or isinstance(result.exception, SystemExit)
     for frag in fragments:
         assert frag in err[0], (frag, err[0])
+    return err[0]
 
 
 # --------------------------------------------------------------------------- models

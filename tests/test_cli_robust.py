@@ -24,6 +24,7 @@ import time
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from test_cli import assert_one_line_error as one_line_error
 
 import brdfkit
 import brdfkit.pumping
@@ -37,17 +38,6 @@ def run(*args: str):
     return CliRunner().invoke(main, list(args))
 
 
-def one_line_error(result, *fragments: str) -> str:
-    """Exit status 2, exactly one stderr line 'brdfkit: error: ...', no traceback."""
-    assert result.exit_code == 2, (result.exit_code, result.output, result.stderr)
-    err = result.stderr.strip().splitlines()
-    assert len(err) == 1, result.stderr
-    assert err[0].startswith("brdfkit: error: "), err[0]
-    assert "Traceback" not in result.output + result.stderr
-    assert result.exception is None or isinstance(result.exception, SystemExit)
-    for frag in fragments:
-        assert frag in err[0], (frag, err[0])
-    return err[0]
 
 
 def _env() -> dict:

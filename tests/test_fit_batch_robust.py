@@ -22,6 +22,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 from test_fit_batch import JOBS, closed_form, job_fn
+from test_fit_distributed import _until as until
 
 import brdfkit
 from brdfkit.cli import main
@@ -46,13 +47,7 @@ WAIT_S = 60.0
 
 
 def _until(what, check, timeout=WAIT_S, every=0.05):
-    t0 = time.monotonic()
-    while time.monotonic() - t0 < timeout:
-        got = check()
-        if got:
-            return got
-        time.sleep(every)
-    raise AssertionError(f"waited {timeout} s for {what}")
+    return until(what, check, timeout, every)
 
 
 def _kill_group(proc) -> None:
