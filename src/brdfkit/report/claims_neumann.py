@@ -143,12 +143,13 @@ def _eq19(ctx):
 def _eq19_rule(numbers, tol) -> Outcome:
     ok, parts = True, []
     for k, v in numbers["models"].items():
-        a, b = np.array(v["a"]), np.array(v["a_star"])
-        below = a < 1.0 - tol  # where a = 1 the paper's Ω_V is empty and a* = a = 1
-        ok &= bool(np.all(a[below] < b[below]) and np.all(b <= 1.0 + tol)
-                   and np.all(np.abs(b[~below] - 1.0) <= tol))
-        parts.append(f"{k}: a = {', '.join(f'{x:.3f}' for x in a)}; a* = "
-                     f"{', '.join(f'{x:.3f}' for x in b)}; max a* = {np.max(b):.7f}")
+        a_base, a_star = np.array(v["a"]), np.array(v["a_star"])
+        below = a_base < 1.0 - tol  # where a = 1 the paper's Ω_V is empty and a* = a = 1
+        ok &= bool(np.all(a_base[below] < a_star[below]) and np.all(a_star <= 1.0 + tol)
+                   and np.all(np.abs(a_star[~below] - 1.0) <= tol))
+        parts.append(f"{k}: a = {', '.join(f'{x:.3f}' for x in a_base)}; a* = "
+                     f"{', '.join(f'{x:.3f}' for x in a_star)}; max a* = "
+                     f"{np.max(a_star):.7f}")
     return Outcome("confirmed" if ok else "refuted",
                    "θ_i = 0…89° (9 angles), pumped once with g₁: " + "; ".join(parts)
                    + " (where a = 1, at normal incidence, a* = 1 as the paper says).")
