@@ -51,3 +51,55 @@ def test_table2_markdown_has_the_legend_the_plain_table_has():
     legend = plain.splitlines()[0]
     assert legend.startswith("Lewis 1993 Table 2") and md.splitlines()[0] == legend
     assert "| model |" in md
+
+
+def test_compare_takes_a_models_own_words_in_figure_and_render(tmp_path):
+    # `figure --compare` took specs at their defaults only, and `render sphere` had no way
+    # to put two models side by side at one exposure (issue 20)
+    import math
+
+    import numpy as np
+
+    import brdfkit
+    from brdfkit.cli._common import build_model_words
+    from brdfkit.render import exposure_phi0, render_sphere
+    from brdfkit.render.image import panel_gap
+
+    m = build_model_words("nielsen -p k_s=5 -p s=200 --pump max --times 2")
+    want = brdfkit.pumping.pump(brdfkit.model("nielsen", k_s=5.0, s=200.0), g="max", times=2)
+    assert m.to_dict() == want.to_dict()
+    bad = run("figure", "slices", "--model", "lambert", "--compare", "nielsen -q 1", "--out",
+              tmp_path / "s.png")
+    assert bad.exit_code == 2 and "--compare 'nielsen -q 1': the word '-q'" in bad.output
+    ok = run("figure", "slices", "--model", "lambert", "--compare", "nielsen -p k_s=5",
+             "--out", tmp_path / "s.png")
+    assert ok.exit_code == 0, ok.output
+
+    # side by side: each panel is the model's own render (the API's, independently), the
+    # panels S/32 black pixels apart; a PNG's one exposure is the brightest panel's phi0 rule
+    S, phi = 32, 30.0
+    out = tmp_path / "two.npy"
+    r = run("render", "sphere", "microfacet", "-p", "alpha=0.2", "--compare",
+            "lambert -p rho_d=0.5", "--phi-l", phi, "--size", S, "--out", out)
+    assert r.exit_code == 0, r.output
+    img = np.load(out)
+    a = render_sphere(brdfkit.model("microfacet", alpha=0.2), phi_l=math.radians(phi),
+                      size=S).radiance
+    b = render_sphere(brdfkit.model("lambert", rho_d=0.5), phi_l=math.radians(phi),
+                      size=S).radiance
+    g = panel_gap(S)
+    assert img.shape == (S, 2 * S + g, 1)
+    np.testing.assert_array_equal(img[:, :S], a)
+    np.testing.assert_array_equal(img[:, S:S + g], 0.0)
+    np.testing.assert_array_equal(img[:, S + g:], b)
+    r = run("render", "sphere", "microfacet", "-p", "alpha=0.2", "--compare",
+            "lambert -p rho_d=0.5", "--phi-l", phi, "--size", S, "--out", tmp_path / "t.png",
+            "--json")
+    meta = json.loads(r.output)
+    k = min(exposure_phi0(brdfkit.model("microfacet", alpha=0.2), size=S),
+            exposure_phi0(brdfkit.model("lambert", rho_d=0.5), size=S))
+    assert meta["exposure"] == pytest.approx(k, rel=1e-12) and len(meta["panels"]) == 2
+    assert [p["model"]["model"] for p in meta["panels"]] == ["microfacet", "lambert"]
+    four = run("render", "sphere", "lambert", *sum((["--compare", "lambert"] for _ in range(4)),
+                                                   []), "--phi-l", 0, "--out", tmp_path / "f.png")
+    assert four.exit_code == 2 and "--compare takes at most 3 models" in four.output

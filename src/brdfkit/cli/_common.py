@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import json
 import math
+import shlex
 from collections.abc import Callable, Iterable, Mapping
 
 import click
@@ -50,6 +51,7 @@ __all__ = [
     "model_options",
     "parse_param_items",
     "build_model",
+    "build_model_words",
     "parse_direction",
     "to_jsonable",
     "emit_json",
@@ -104,6 +106,46 @@ def build_model(name: str, params: Iterable[str] | Mapping = (), pump: str | Non
     """
     return ModelSpec.parse(name, params, pump=pump, times=times,
                            compensate=compensate).build()
+
+
+#: The words a --compare SPEC may carry after its spec, as MODEL takes them.
+_MODEL_WORDS = {"-p": "params", "--param": "params", "--pump": "pump", "--times": "times",
+                "--compensate": "compensate"}
+
+
+def build_model_words(text: str, *, option: str = "--compare"):
+    """Build the model of one quoted option value written as a command line writes MODEL:
+    ``'SPEC [-p NAME=VALUE]... [--compensate M] [--pump G [--times K]]'`` (shell quoting);
+    a bare spec is the model at its defaults. Errors name *option* and the word."""
+    try:
+        words = shlex.split(str(text))
+    except ValueError as exc:
+        raise BrdfkitError(f"{option} {text!r}: {exc}") from None
+    if not words:
+        raise BrdfkitError(f"{option} needs a model spec (e.g. {option} 'nielsen -p k_s=5'); "
+                           "got an empty value")
+    target, params, ops = words[0], [], {}
+    k = 1
+    while k < len(words):
+        key = _MODEL_WORDS.get(words[k])
+        if key is None or k + 1 >= len(words):
+            what = "has no value" if key is not None else "is not one of " + ", ".join(
+                sorted(set(_MODEL_WORDS) - {"--param"}))
+            raise BrdfkitError(f"{option} {text!r}: the word {words[k]!r} {what} (after the "
+                               "spec: -p NAME=VALUE, --compensate M, --pump G, --times K)")
+        if key == "params":
+            params.append(words[k + 1])
+        else:
+            ops[key] = words[k + 1]
+        k += 2
+    times = ops.get("times")
+    if times is not None:
+        try:
+            times = int(times)
+        except ValueError:
+            raise BrdfkitError(f"{option} {text!r}: --times must be a whole number; got "
+                               f"{times!r}") from None
+    return build_model(target, params, ops.get("pump"), times, ops.get("compensate"))
 
 
 def _times_callback(ctx: click.Context, param: click.Parameter, value):

@@ -21,9 +21,10 @@ import click
 import numpy as np
 
 from brdfkit import _io
-from brdfkit.cli._common import build_model, emit_json, model_options
+from brdfkit.cli._common import build_model, build_model_words, emit_json, model_options
 from brdfkit.errors import BrdfkitError
 from brdfkit.render import MAX_SIZE, SUFFIXES, exposure_phi0, render_sphere, save_render
+from brdfkit.render.image import save_panels
 from brdfkit.render.mitsuba_bridge import (
     MAX_SAMPLES,
     MITSUBA_MAX_SIZE,
@@ -34,7 +35,10 @@ from brdfkit.render.mitsuba_bridge import (
 from brdfkit.render.silhouette import DEFAULT_ANTIALIAS, MAX_ANTIALIAS
 from brdfkit.render.sphere import BYTES_PER_VALUE, DEFAULT_SPP
 
-__all__ = ["render_group", "sphere_cmd", "parse_exposure"]
+__all__ = ["render_group", "sphere_cmd", "parse_exposure", "MAX_COMPARE"]
+
+#: Most --compare models of one render (four panels side by side).
+MAX_COMPARE = 3
 
 
 def parse_exposure(text: str) -> float | str:
@@ -99,9 +103,15 @@ def render_group() -> None:
 @click.option("--out", required=True, metavar="FILE",
               help="Output file: .png (sRGB), .exr (linear, 32-bit float) or .npy (linear, "
                    "float64). Written atomically.")
+@click.option("--compare", multiple=True, metavar="'SPEC [-p NAME=VALUE]...'",
+              help=f"Render this model too, beside MODEL in one image at one exposure "
+                   f"(repeatable, up to {MAX_COMPARE}): a spec with its own -p, --compensate, "
+                   "--pump, --times words, quoted, e.g. --compare 'nielsen -p k_s=5'. Panels "
+                   "left to right, S/32 black pixels apart; phi0/peak expose the brightest "
+                   "of them.")
 @click.option("--json", "as_json", is_flag=True, help="Print the render's metadata as JSON.")
 def sphere_cmd(model, param, compensate, pump, times, phi_l, ambient, irradiance, size, engine,
-               spp, seed, variant, antialias, exposure, out, as_json):
+               spp, seed, variant, antialias, compare, exposure, out, as_json):
     """Render MODEL on Lewis's sphere test configuration (Lewis 1993, Fig. 2).
 
     An S x S orthographic image of the unit sphere seen from +z, one
@@ -147,29 +157,43 @@ def sphere_cmd(model, param, compensate, pump, times, phi_l, ambient, irradiance
         check_samples(size * size, DEFAULT_SPP if spp is None else spp, size_name="--size")
     rule = parse_exposure(exposure)
     _io.check_output_path(out, option="--out", suffixes=SUFFIXES)  # before any work
-    m = build_model(model, param, pump, times, compensate)
-    result = render_sphere(m, phi_l=math.radians(phi_l), ambient=ambient,
-                           irradiance=irradiance, size=size, engine=engine, spp=spp, seed=seed,
-                           **aa)
-    if not np.all(np.isfinite(result.radiance)):
+    if len(compare) > MAX_COMPARE:
+        raise BrdfkitError(f"--compare takes at most {MAX_COMPARE} models (one image of "
+                           f"{MAX_COMPARE + 1} panels); got {len(compare)}")
+    models = [build_model(model, param, pump, times, compensate),
+              *(build_model_words(c, option="--compare") for c in compare)]
+    results = [render_sphere(m, phi_l=math.radians(phi_l), ambient=ambient,
+                             irradiance=irradiance, size=size, engine=engine, spp=spp,
+                             seed=seed, **aa) for m in models]
+    if not all(np.all(np.isfinite(r.radiance)) for r in results):
         raise BrdfkitError(f"the radiance is not finite (it overflows at --irradiance "
                            f"{irradiance:g}, --ambient {ambient:g}); lower them ({out} is not "
                            "written)")
     k, how = None, ""
     if out.lower().endswith(".png"):
+        several = " (the brightest of the panels)" if len(results) > 1 else ""
         if rule == "phi0":
-            k = exposure_phi0(m, ambient=ambient, irradiance=irradiance, size=size)
-            how = "1/peak of the same sphere at phi_L = 0 (Lewis 1993 Sec. 3.3)"
+            k = min(exposure_phi0(m, ambient=ambient, irradiance=irradiance, size=size)
+                    for m in models)
+            how = "1/peak of the same sphere at phi_L = 0 (Lewis 1993 Sec. 3.3)" + several
         elif rule == "peak":
-            if not result.peak > 0.0:
+            peak = max(r.peak for r in results)
+            if not peak > 0.0:
                 raise BrdfkitError("--exposure peak: the image is black (peak radiance 0); "
                                    "give --exposure K")
-            k, how = 1.0 / result.peak, "1/peak of this image"
+            k, how = 1.0 / peak, "1/peak of this image" + several
         else:
             k, how = rule, "given (--exposure)"
-    save_render(result, out, exposure=k, exposure_rule=how, option="--out")
+    if len(results) == 1:
+        save_render(results[0], out, exposure=k, exposure_rule=how, option="--out")
+        meta = dict(results[0].metadata(), out=out, exposure=k, exposure_rule=how)
+    else:
+        meta = {"panels": [r.metadata() for r in results], "out": out, "exposure": k,
+                "exposure_rule": how}
+        save_panels([r.radiance for r in results], out, exposure=k, metadata=meta,
+                    option="--out")
     if as_json:
-        emit_json(dict(result.metadata(), out=out, exposure=k, exposure_rule=how))
+        emit_json(meta)
     else:
         click.echo(out)
 

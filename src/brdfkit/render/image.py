@@ -43,8 +43,8 @@ import numpy as np
 from brdfkit import _io
 from brdfkit.errors import BrdfkitError, ParameterError
 
-__all__ = ["SUFFIXES", "save_render", "write_npy", "write_exr", "write_png", "srgb_encode",
-           "to_srgb8", "exr_channel_names"]
+__all__ = ["SUFFIXES", "save_render", "save_panels", "panels", "panel_gap", "write_npy",
+           "write_exr", "write_png", "srgb_encode", "to_srgb8", "exr_channel_names"]
 
 #: Output formats, chosen by the file's suffix.
 SUFFIXES = (".png", ".exr", ".npy")
@@ -241,3 +241,49 @@ def save_render(render, path, *, exposure: float | None = None, exposure_rule: s
         exposure, exposure_rule = 1.0 / peak, "peak of this image"
     meta = dict(render.metadata(), exposure=float(exposure), exposure_rule=exposure_rule)
     return write_png(p, render.radiance, exposure=exposure, metadata=meta, option=option)
+
+
+def panels(images) -> np.ndarray:
+    """Square images (S, S, C) side by side, left to right, :func:`panel_gap` black pixels
+    apart: (S, n·S + (n − 1)·gap, C). One channel is repeated to three beside RGB ones
+    (a grey model next to a coloured one); other channel counts must agree."""
+    imgs = [np.asarray(a, dtype=np.float64) for a in images]
+    chans = {a.shape[2] for a in imgs}
+    if chans == {1, 3}:
+        imgs = [np.repeat(a, 3, axis=2) if a.shape[2] == 1 else a for a in imgs]
+    elif len(chans) > 1:
+        raise BrdfkitError(f"the panels have {sorted(chans)} channels: only 1 and 3 mix "
+                           "(grey shown as RGB); compare models of one channel count")
+    S, C = imgs[0].shape[0], imgs[0].shape[2]
+    gap = np.zeros((S, panel_gap(S), C))
+    out = [imgs[0]]
+    for a in imgs[1:]:
+        out += [gap, a]
+    return np.concatenate(out, axis=1)
+
+
+def panel_gap(size: int) -> int:
+    """Black pixels between panels: S/32, at least 1."""
+    return max(1, size // 32)
+
+
+def save_panels(images, path, *, exposure: float | None, metadata: dict,
+                option: str = "path") -> str:
+    """Write :func:`panels` of *images* (renders' radiance) to *path*: ``.png`` at the one
+    *exposure* with *metadata* in its tEXt chunk, ``.exr`` with it as an attribute,
+    ``.npy`` the linear array."""
+    p = _io.check_output_path(path, option=option, suffixes=SUFFIXES)
+    rad = panels(images)
+    suffix = p.lower().rsplit(".", 1)[-1]
+    if suffix == "npy":
+        return write_npy(p, rad, option=option)
+    if suffix == "exr":
+        return write_exr(p, rad, metadata=metadata, option=option)
+    if exposure is None:  # as save_render: the brightest pixel just unsaturated
+        peak = float(np.max(rad)) if rad.size else 0.0
+        if not peak > 0.0:
+            raise BrdfkitError("the panels are black (peak radiance 0), so no exposure can be "
+                               "derived from them; give an explicit exposure")
+        exposure = 1.0 / peak
+    return write_png(p, rad, exposure=exposure, metadata=metadata, option=option)
+
