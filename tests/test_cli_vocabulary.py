@@ -103,3 +103,18 @@ def test_compare_takes_a_models_own_words_in_figure_and_render(tmp_path):
     four = run("render", "sphere", "lambert", *sum((["--compare", "lambert"] for _ in range(4)),
                                                    []), "--phi-l", 0, "--out", tmp_path / "f.png")
     assert four.exit_code == 2 and "--compare takes at most 3 models" in four.output
+
+
+def test_a_metal_under_one_light_gets_a_note_that_ambient_shows_it(tmp_path):
+    # issue 20: metals under one directional light are a black disc with a dot. A smooth
+    # conductor (α = 0.05, no diffuse term) lights only its highlight; a Lambertian sphere
+    # lights half the disc (N·L > 0 at Φ_L = 30°): the note for the first only.
+    metal = run("render", "sphere", "microfacet", "-p", "alpha=0.05", "--phi-l", 30,
+                "--size", 64, "--out", tmp_path / "m.png")
+    assert metal.exit_code == 0 and "--ambient 0.5" in metal.stderr
+    lit = run("render", "sphere", "microfacet", "-p", "alpha=0.05", "--phi-l", 30,
+              "--size", 64, "--ambient", "0.5", "--out", tmp_path / "a.png")
+    assert lit.exit_code == 0 and lit.stderr == ""
+    diffuse = run("render", "sphere", "lambert", "--phi-l", 30, "--size", 64, "--out",
+                  tmp_path / "l.png")
+    assert diffuse.exit_code == 0 and diffuse.stderr == ""

@@ -39,6 +39,19 @@ __all__ = ["render_group", "sphere_cmd", "parse_exposure", "MAX_COMPARE"]
 
 #: Most --compare models of one render (four panels side by side).
 MAX_COMPARE = 3
+#: A render is "black but for its highlight" when fewer than this share of the disc's
+#: pixels reach DARK_LEVEL of its peak (a metal with α = 0.05 under one light: ~1 %).
+DARK_SHARE = 0.05
+#: The level, relative to the peak, below which a pixel reads as black on a display (8-bit
+#: sRGB: 1 % is code 25 of 255).
+DARK_LEVEL = 0.01
+
+
+def _mostly_dark(result) -> bool:
+    """Whether fewer than DARK_SHARE of the disc's pixels reach DARK_LEVEL of the peak."""
+    disc = result.radiance[result.mask].max(axis=-1)
+    peak = float(disc.max()) if disc.size else 0.0
+    return peak > 0.0 and float(np.mean(disc >= DARK_LEVEL * peak)) < DARK_SHARE
 
 
 def parse_exposure(text: str) -> float | str:
@@ -169,6 +182,10 @@ def sphere_cmd(model, param, compensate, pump, times, phi_l, ambient, irradiance
         raise BrdfkitError(f"the radiance is not finite (it overflows at --irradiance "
                            f"{irradiance:g}, --ambient {ambient:g}); lower them ({out} is not "
                            "written)")
+    if ambient == 0.0 and any(_mostly_dark(r) for r in results):
+        click.echo("brdfkit: note: the sphere is black but for its highlight (a glossy or "
+                   "metallic model under one light); --ambient 0.5 adds uniform light that "
+                   "shows its whole response", err=True)
     k, how = None, ""
     if out.lower().endswith(".png"):
         several = " (the brightest of the panels)" if len(results) > 1 else ""
