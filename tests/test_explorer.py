@@ -182,6 +182,31 @@ def test_page_fits_a_model_to_a_material(browser, server):
     fitted = page.locator("#model-list .model").nth(2).locator("input[data-param='rho_d']")
     rho = [float(x) for x in fitted.first.input_value().split(",")]
     np.testing.assert_allclose(rho, 0.3, rtol=1e-3)
+    # the fitted entry is named apart from the model it was fitted from (issue 20: a second
+    # entry with the same name)
+    names = page.locator("#model-list .name").all_text_contents()
+    assert names[1] == "lambert" and names[2] == f"lambert fitted to {path}", names
+    assert errors == []
+    page.close()
+
+
+def test_page_refuses_an_unknown_spec_with_a_message(browser, server):
+    """issue 20: an unknown spec typed into "add" stayed in the list. Now it is not added and
+    the message says why (with the catalog's near names); a known one is added."""
+    page, errors = open_page(browser, _url(server, [{"spec": "lambert", "params": {}}]))
+    page.fill("#add-spec", "modifed-phong")
+    page.press("#add-spec", "Enter")
+    assert page.locator("#model-list .model").count() == 1
+    msg = page.locator("#message").text_content()
+    assert "unknown model or material 'modifed-phong'" in msg and "modified-phong" in msg
+    page.fill("#add-spec", "/tmp/x.binary")
+    page.press("#add-spec", "Enter")
+    assert page.locator("#model-list .model").count() == 1
+    assert "open file" in page.locator("#message").text_content()
+    page.fill("#add-spec", "merl:nickel@abc")
+    page.press("#add-spec", "Enter")
+    assert page.locator("#model-list .model").count() == 2
+    wait_ready(page)
     assert errors == []
     page.close()
 

@@ -169,6 +169,23 @@ function paramSlider(p, input) {
   return slider;
 }
 
+// Why *spec* cannot be added by name (null: it can): not a registered model, alias or
+// built-in material of the catalog. A file is added by path through "open file".
+function unknownSpec(spec) {
+  if (!catalog) return null;  // the server checks it then (the model's error in the list)
+  const key = spec.toLowerCase().replace(/_/g, "-");
+  const names = [];
+  for (const m of catalog.models) names.push(m.name, ...(m.aliases || []));
+  if (names.includes(key) || catalog.materials.includes(spec)) return null;
+  if (/[\\/]|\.(binary|brdf|py)(:|$)/i.test(spec)) {
+    return "'" + spec + "' is a file: open it with 'open file' (by its path on this machine)";
+  }
+  const close = names.concat(catalog.materials).filter(n => n.startsWith(key.slice(0, 3)));
+  return "unknown model or material '" + spec + "'" +
+    (close.length ? " (did you mean " + close.slice(0, 3).join(", ") + "?)" : "") +
+    "; not added";
+}
+
 function renderModelList() {
   const list = document.getElementById("model-list");
   list.innerHTML = "";
@@ -181,7 +198,8 @@ function renderModelList() {
     const name = document.createElement("span");
     // a file model by its file's name (the whole path on the line below and in the title)
     name.className = "name"; name.title = entry.spec;
-    name.textContent = info && info.file ? entry.spec.split("/").pop() : entry.spec;
+    name.textContent = (info && info.file ? entry.spec.split("/").pop() : entry.spec) +
+      (entry.fitted_to ? " fitted to " + entry.fitted_to : "");
     head.appendChild(name);
     const vis = document.createElement("input");
     vis.type = "checkbox"; vis.checked = entry.visible !== false; vis.title = "show";
@@ -625,6 +643,8 @@ async function init() {
     ev.preventDefault();
     const spec = document.getElementById("add-spec").value.trim();
     if (!spec) return;
+    const problem = unknownSpec(spec);
+    if (problem) { showMessage(problem); return; }  // an unknown spec never enters the list
     state.models.push({ spec, params: {}, pump: null, times: 1, visible: true });
     document.getElementById("add-spec").value = "";
     renderModelList(); update();
