@@ -208,7 +208,7 @@ def sphere_cmd(model, param, compensate, pump, times, phi_l, ambient, irradiance
         meta = {"panels": [r.metadata() for r in results], "out": out, "exposure": k,
                 "exposure_rule": how}
         save_panels([r.radiance for r in results], out, exposure=k, metadata=meta,
-                    option="--out")
+                    exposure_rule=how, option="--out")
     if as_json:
         emit_json(meta)
     else:

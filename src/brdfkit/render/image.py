@@ -43,8 +43,9 @@ import numpy as np
 from brdfkit import _io
 from brdfkit.errors import BrdfkitError, ParameterError
 
-__all__ = ["SUFFIXES", "save_render", "save_panels", "panels", "panel_gap", "write_npy",
-           "write_exr", "write_png", "srgb_encode", "to_srgb8", "exr_channel_names"]
+__all__ = ["SUFFIXES", "save_render", "save_panels", "panels", "panel_gap", "write_radiance",
+           "write_npy", "write_exr", "write_png", "srgb_encode", "to_srgb8",
+           "exr_channel_names"]
 
 #: Output formats, chosen by the file's suffix.
 SUFFIXES = (".png", ".exr", ".npy")
@@ -227,20 +228,30 @@ def save_render(render, path, *, exposure: float | None = None, exposure_rule: s
     option : str, keyword-only
         How the caller names *path* in errors (the CLI passes ``"--out"``).
     """
+    return write_radiance(path, render.radiance, exposure=exposure, metadata=render.metadata(),
+                          exposure_rule=exposure_rule, option=option)
+
+
+def write_radiance(path, radiance, *, exposure: float | None = None, metadata: dict,
+                   exposure_rule: str = "", option: str = "path") -> str:
+    """Write linear *radiance* (rows, cols, C) to *path*, the format from its suffix:
+    ``.npy``; ``.exr`` with *metadata* as an attribute; ``.png`` at *exposure* (None: 1/peak,
+    the brightest pixel just unsaturated) with *metadata*, the exposure and *exposure_rule*
+    in its tEXt chunk."""
     p = _io.check_output_path(path, option=option, suffixes=SUFFIXES)
     suffix = p.lower().rsplit(".", 1)[-1]
     if suffix == "npy":
-        return write_npy(p, render.radiance, option=option)
-    if suffix == "exr":  # linear: no exposure, the render's own metadata
-        return write_exr(p, render.radiance, metadata=render.metadata(), option=option)
+        return write_npy(p, radiance, option=option)
+    if suffix == "exr":  # linear: no exposure
+        return write_exr(p, radiance, metadata=metadata, option=option)
     if exposure is None:
-        peak = render.peak
+        peak = float(np.max(radiance)) if np.size(radiance) else 0.0
         if not peak > 0.0:
             raise BrdfkitError("the image is black (peak radiance 0), so no exposure can be "
                                "derived from it; give an explicit exposure")
         exposure, exposure_rule = 1.0 / peak, "peak of this image"
-    meta = dict(render.metadata(), exposure=float(exposure), exposure_rule=exposure_rule)
-    return write_png(p, render.radiance, exposure=exposure, metadata=meta, option=option)
+    meta = dict(metadata, exposure=float(exposure), exposure_rule=exposure_rule)
+    return write_png(p, radiance, exposure=exposure, metadata=meta, option=option)
 
 
 def panels(images) -> np.ndarray:
@@ -268,22 +279,8 @@ def panel_gap(size: int) -> int:
 
 
 def save_panels(images, path, *, exposure: float | None, metadata: dict,
-                option: str = "path") -> str:
-    """Write :func:`panels` of *images* (renders' radiance) to *path*: ``.png`` at the one
-    *exposure* with *metadata* in its tEXt chunk, ``.exr`` with it as an attribute,
-    ``.npy`` the linear array."""
-    p = _io.check_output_path(path, option=option, suffixes=SUFFIXES)
-    rad = panels(images)
-    suffix = p.lower().rsplit(".", 1)[-1]
-    if suffix == "npy":
-        return write_npy(p, rad, option=option)
-    if suffix == "exr":
-        return write_exr(p, rad, metadata=metadata, option=option)
-    if exposure is None:  # as save_render: the brightest pixel just unsaturated
-        peak = float(np.max(rad)) if rad.size else 0.0
-        if not peak > 0.0:
-            raise BrdfkitError("the panels are black (peak radiance 0), so no exposure can be "
-                               "derived from them; give an explicit exposure")
-        exposure = 1.0 / peak
-    return write_png(p, rad, exposure=exposure, metadata=metadata, option=option)
-
+                exposure_rule: str = "", option: str = "path") -> str:
+    """Write :func:`panels` of *images* (renders' radiance) to *path* as
+    :func:`write_radiance` does, with *metadata* (one exposure for every panel)."""
+    return write_radiance(path, panels(images), exposure=exposure, metadata=metadata,
+                          exposure_rule=exposure_rule, option=option)

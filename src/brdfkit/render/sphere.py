@@ -460,18 +460,24 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
         raise ParameterError(f"light_azimuth must be a finite angle in radians; got "
                              f"{light_azimuth!r}")
     L = (math.sin(phi) * math.cos(psi), math.sin(phi) * math.sin(psi), math.cos(phi))
-    # the pixels the rim or the terminator crosses (module silhouette), when anti-aliasing
-    rim = (edge_pixels(S, L) if antialias > 1 and E > 0.0 else silhouette_pixels(S)
-           if antialias > 1 else np.empty(0, dtype=np.int64))
+    # the pixels the rim crosses and, lit by the light (E > 0), the terminator (module
+    # silhouette); none without anti-aliasing
+    if antialias == 1:
+        rim = np.empty(0, dtype=np.int64)
+    elif E > 0.0:
+        rim = edge_pixels(S, L)
+    else:
+        rim = silhouette_pixels(S)
     sx, sy = silhouette_samples(S, rim, int(antialias))
     err, msg, ok = 0.0, "", True
+    table, theta_max = None, 0.0  # the ambient table, when L_a > 0
     if L_a > 0.0:  # the ambient image first; the direct term is added to it
         # at least 1e-3 rad: the one pixel of a 1×1 image has θ_V = 0; the table needs a range
         # the rim's sub-samples reach closer to the horizon than any centre: the table
         # covers them up to RIM_THETA_MAX (beyond, a sliver of < 1e-3 of a pixel's width,
         # they read the table's last value)
-        r2 = max(_max_r2(S), float(np.max(np.where(sx * sx + sy * sy < 1.0,
-                                                   sx * sx + sy * sy, 0.0), initial=0.0)))
+        r2_sub = sx * sx + sy * sy
+        r2 = max(_max_r2(S), float(np.max(r2_sub[r2_sub < 1.0], initial=0.0)))
         theta_max = min(max(math.acos(math.sqrt(max(1.0 - r2, 0.0))), 1e-3), RIM_THETA_MAX)
         table = ambient_table(model, theta_max=theta_max, tol=rho_tol)
         out = L_a * _rho_image(table, S, C)
@@ -489,10 +495,8 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
         if k:
             f = np.asarray(model.eval(wi[:k], wo[:k]), dtype=np.float64).reshape(k, C)
             _scatter(out, index[:k], E * cos_l[:k], np.ascontiguousarray(f))
-    if rim.size:
-        out = np.array(out)  # the ambient image is a cached read-only array
-        out[rim] = _rim_means(model, sx, sy, L, E, L_a, table if L_a > 0.0 else None,
-                              theta_max if L_a > 0.0 else 0.0, C)
+    if rim.size:  # out is this render's own array (L_a·ρ image or zeros): written in place
+        out[rim] = _rim_means(model, sx, sy, L, E, L_a, table, theta_max, C)
     _, mask = _disc(S)
     status = (_CODES.NONFINITE if not np.all(np.isfinite(out))
               else _CODES.CONVERGED if ok else _CODES.LIMIT)
