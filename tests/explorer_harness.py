@@ -28,6 +28,19 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
+def wait_answering(url: str, *, tries: int = 300, every: float = 0.1) -> None:
+    """Wait until a GET of *url* answers (a server process starting: brdfkit and Numba
+    import first); at most *tries* × *every* seconds, then the caller's request fails."""
+    import urllib.request
+
+    for _ in range(tries):
+        try:
+            urllib.request.urlopen(url, timeout=5)
+            return
+        except OSError:
+            time.sleep(every)
+
+
 @pytest.fixture(scope="module")
 def server():
     import tempfile

@@ -29,7 +29,7 @@ import urllib.parse
 
 import numpy as np
 import pytest
-from explorer_harness import TEST_BUDGET_S, free_port, open_page
+from explorer_harness import TEST_BUDGET_S, free_port, open_page, wait_answering
 
 import brdfkit
 from brdfkit.data.export import export_merl
@@ -461,12 +461,7 @@ def test_explore_command_serves_file_specs(tmp_path):
         state = {"models": [{"spec": s, "params": {}, "pump": None, "times": 1,
                              "visible": True} for s in specs]}
         base = f"http://127.0.0.1:{port}"
-        for _ in range(100):
-            try:
-                urllib.request.urlopen(base + "/api/changes", timeout=5)
-                break
-            except OSError:
-                time.sleep(0.1)
+        wait_answering(base + "/api/changes", tries=100)
         req = urllib.request.Request(base + "/api/views", data=json.dumps(state).encode(),
                                      headers={"Content-Type": "application/json"})
         got = json.load(urllib.request.urlopen(req, timeout=120))

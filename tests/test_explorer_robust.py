@@ -29,7 +29,7 @@ import urllib.error
 import urllib.request
 
 import pytest
-from explorer_harness import free_port
+from explorer_harness import free_port, wait_answering
 
 from brdfkit.explorer import guard
 
@@ -51,12 +51,7 @@ def _start(tmp_path, *extra):
          "--budget", str(BUDGET_S), "--allow-dir", str(allowed), *extra],
         cwd=tmp_path, stderr=subprocess.PIPE, text=True)
     base = f"http://127.0.0.1:{port}"
-    for _ in range(300):
-        try:
-            urllib.request.urlopen(base + "/api/catalog", timeout=5)
-            break
-        except OSError:
-            time.sleep(0.1)
+    wait_answering(base + "/api/catalog")
     return proc, base
 
 
