@@ -32,8 +32,9 @@ What is not a cache, and so not made here: registries filled once at import
 (models, formulas, primitives, figures), and per-object lazily computed
 attributes derived from the object's own immutable state (a model's lobe
 width, a measured table's interleaved copy), which die with the object.
-Caches on disk (Numba's, :mod:`brdfkit.models._drivers`' generated modules)
-are a different mechanism, keyed on a stamp of the sources.
+Caches on disk (Numba's, :mod:`brdfkit.models._drivers`' generated modules, the
+results of ``brdfkit reproduce``) are a different mechanism, keyed on a stamp of the
+sources; brdfkit's own live under :func:`disk_cache_dir`.
 
 Thread safety: insertions, evictions and clearing hold a lock; reads rely on
 the atomicity of dict operations under the GIL (the hit and miss counters are
@@ -49,21 +50,24 @@ Public objects
   ``len``, ``setdefault``, ``pop``, ``clear``, ``info``).
 - :func:`clear_caches`, :func:`cache_info` — every cache at once.
 - :data:`CACHES` — the registry: name → cache.
+- :func:`disk_cache_dir` — the directory of one of brdfkit's caches on disk.
 """
 
 from __future__ import annotations
 
 import functools
+import os
 import threading
 import weakref
 from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 from brdfkit.errors import ParameterError
 
 __all__ = ["CACHES", "BoundedCache", "CacheInfo", "bounded_cache", "cache_info",
-           "clear_caches", "memo"]
+           "clear_caches", "memo", "disk_cache_dir"]
 
 #: Every named cache, by name (module-level caches: they live as long as the process).
 CACHES: dict[str, BoundedCache] = {}
@@ -272,3 +276,13 @@ def cache_info() -> list[CacheInfo]:
     """The state of every cache, named ones first (sorted by name)."""
     named = sorted((c.info() for c in CACHES.values()), key=lambda i: i.name)
     return named + [c.info() for c in list(_ANONYMOUS)]
+
+
+def disk_cache_dir(name: str) -> Path:
+    """``ROOT/name``: ROOT is ``$BRDFKIT_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/brdfkit``
+    (default ``~/.cache/brdfkit``); not created here."""
+    root = os.environ.get("BRDFKIT_CACHE_DIR")
+    if not root:
+        xdg = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+        root = os.path.join(xdg, "brdfkit")
+    return Path(root) / name

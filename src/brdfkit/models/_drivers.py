@@ -82,7 +82,7 @@ import numba
 import numpy as np
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
-from brdfkit._cache import bounded_cache, memo
+from brdfkit._cache import bounded_cache, disk_cache_dir, memo
 from brdfkit._kern import load_input, store_output
 from brdfkit._threads import numba_threads  # noqa: F401  (re-exported)
 
@@ -397,11 +397,7 @@ _generated = bounded_cache("brdfkit.models._drivers._generated", maxsize=1024)
 
 def cache_dir() -> Path:
     """The directory holding the generated driver modules (not created here)."""
-    root = os.environ.get("BRDFKIT_CACHE_DIR")
-    if not root:
-        xdg = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-        root = os.path.join(xdg, "brdfkit")
-    return Path(root) / "drivers"
+    return disk_cache_dir("drivers")
 
 
 @memo(maxsize=1)  # once per process

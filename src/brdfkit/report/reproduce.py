@@ -39,7 +39,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from brdfkit._cache import memo
+from brdfkit._cache import disk_cache_dir, memo
 from brdfkit.errors import BrdfkitError
 from brdfkit.report.claim_record import Context
 from brdfkit.report.reproduce_items import PAPERS, Item, compute_item, items
@@ -82,11 +82,7 @@ def default_study_dir() -> str:
 
 def cache_root() -> Path:
     """Where results are cached (module docstring)."""
-    root = os.environ.get("BRDFKIT_CACHE_DIR")
-    if not root:
-        xdg = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-        root = os.path.join(xdg, "brdfkit")
-    return Path(root) / "reproduce"
+    return disk_cache_dir("reproduce")
 
 
 def _hash_tree(root: Path, h) -> None:
