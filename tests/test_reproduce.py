@@ -225,6 +225,17 @@ def test_bad_input_is_one_line_exit_2(tmp_path, args, message):
     assert message in res.output and "Traceback" not in res.output
 
 
+def test_an_out_that_cannot_be_created_is_one_line_exit_2():
+    # /proc exists but takes no directory (even for root): makedirs fails there (was a
+    # FileNotFoundError traceback)
+    from brdfkit.cli import main
+
+    res = CliRunner().invoke(main, ["reproduce", "--only", "lewis", "--out",
+                                    "/proc/brdfkit-report"])
+    assert res.exit_code == 2 and "Traceback" not in res.output
+    assert "cannot create the report's directory" in res.output
+
+
 # --------------------------------------------------------------------------- the page
 def test_page_in_chromium_loads_every_image_and_resolves_every_link(nielsen_report, browser):  # noqa: F811
     out, _, _ = nielsen_report

@@ -247,7 +247,11 @@ def reproduce(out, *, only: str | None = None, full: bool = False, jobs: int = 1
         raise BrdfkitError(f"jobs must be an integer >= 1 (worker processes); got {jobs!r}")
     out = os.fspath(out)
     t0 = time.perf_counter()
-    os.makedirs(out, exist_ok=True)
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as exc:  # an unwritable place, a file in the way: one line, no traceback
+        raise BrdfkitError(f"out {out!r}: cannot create the report's directory "
+                           f"({exc.strerror or exc}); choose a writable directory") from None
     if full and study_dir is None:
         study_dir = _full_study(out, jobs=jobs, progress=progress, materials=materials)
     ctx = Context(study_dir=study_dir or default_study_dir(), full=full)
