@@ -23,7 +23,8 @@ target itself is a file, or it is ``PATH.py:NAME`` and ``PATH.py`` is one) — a
   and ``.py`` kinds, whose models are then interpreted) is drawn from its draft at
   once; its real template is resolved in a background thread, one per file content,
   started once the draft's first views are out (:meth:`FileModels.start_compiles`:
-  Numba's compiler holds the GIL), and evaluated once (the *warm* hook: the views,
+  Numba's compiler holds the GIL; one at a time, and one whose file was saved again
+  before its turn is skipped), and evaluated once (the *warm* hook: the views,
   so Numba compiles their loops); then the file's version is raised
   (:meth:`FileWatcher.mark`) and the page draws the compiled model, the same values.
   Compiling fails (a formula Numba cannot type): that content's error, as a broken
@@ -244,6 +245,9 @@ class FileModels:
         self.watcher = FileWatcher() if watcher is None else watcher
         self._warm = warm
         self._lock = threading.Lock()
+        # one compile at a time (Numba's compiler lock serialises them anyway): a waiting
+        # compile whose file changed meanwhile is skipped instead of holding the GIL
+        self._compiling = threading.Lock()
         # (target, digest) -> (path, params) of a draft to compile; those started
         self._pending: dict = {}
         self._started: set = set()
@@ -311,7 +315,12 @@ class FileModels:
                 self._warm(kind.build(template, params))
             return template
 
-        got = _load(compiled, target)
+        with self._compiling:
+            if content_digest(path) != digest:  # superseded: a newer save is drawn (or
+                with self._lock:                # compiled) instead; shown again, it queues
+                    self._started.discard(key)
+                return
+            got = _load(compiled, target)
         with self._lock:
             self._templates[key] = got
             good = self._good.get(target)
