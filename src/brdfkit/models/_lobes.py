@@ -10,6 +10,9 @@ and their common base class.
 Public objects (re-exported by :mod:`brdfkit.models.phong`)
 -----------------------------------------------------------
 - :func:`lobe_pow` — max(0, x)ⁿ with 0⁰ = 1, binary exponentiation for integral n.
+- :func:`lobe_power`, :func:`lobe_mode`, :func:`rv_dot`, :func:`nh_dot` — the same
+  and the dot products of :mod:`brdfkit._kern` as formulas (:mod:`brdfkit._dual`):
+  branch-free, so that the ``"vector"`` loop vectorises them and Mitsuba traces them.
 - :data:`COS_DIVISOR_FLOOR` — floor of a cosine that divides.
 - :class:`CosineLobeBRDF` — base of the cosⁿ-lobe models: strategy-sampled
   (:mod:`brdfkit.models.sampling`), ``beta`` converts by cosⁿβ = 1/2.
@@ -27,13 +30,28 @@ import math
 import numba
 import numpy as np
 
+from brdfkit._dual import Formulas, floor, formula, maximum, power, select, sqrt
+from brdfkit._kern import SMALL_LENGTH
 from brdfkit.halfangle import beta_from_exponent, exponent_from_beta
 from brdfkit.models._base import BRDF, Lobe, Param
+from brdfkit.models._drivers import loop_driver
 from brdfkit.models._params import DIFFUSE_PART
-from brdfkit.models.sampling import COSINE, Mixture, StrategySampled, blinn_lobe, normalised_weights
+from brdfkit.models.sampling import (
+    COSINE,
+    CosPowerAxis,
+    HalfVector,
+    Mixture,
+    PowerHalf,
+    StrategySampled,
+    blinn_lobe,
+    lobes_pdf,
+    lobes_sample,
+    normalised_weights,
+)
 from brdfkit.models.specular import blinn_normal_albedo
 
-__all__ = ["COS_DIVISOR_FLOOR", "CosineLobeBRDF", "lobe_pow"]
+__all__ = ["COS_DIVISOR_FLOOR", "CosineLobeBRDF", "lobe_pow", "lobe_power", "lobe_mode",
+           "rv_dot", "nh_dot", "LOBE_AUTO", "LOBE_INTEGRAL", "LOBE_REAL"]
 
 RHO_D = DIFFUSE_PART  # ρ_d of the diffuse part beside a lobe (models/_params.py)
 RHO_S = Param("rho_s", 0.5, 0.0, 1.0, "",
@@ -82,6 +100,95 @@ def lobe_pow(x: float, n: float) -> float:
     return x**n
 
 
+# ------------------------------------------------------------------ the same as formulas
+#: lobe_power's compile-time mode: AUTO decides per value (both ways evaluated: the class
+#: kernels, any n), INTEGRAL multiplies only (n integral below BINARY_LIMIT: vectorises),
+#: REAL calls pow only (any other n); an instance's loop takes its mode (lobe_mode)
+LOBE_AUTO, LOBE_INTEGRAL, LOBE_REAL = 0, 1, 2
+#: lobe_pow multiplies for integral n below 2¹⁰ (≤ 20 products): ten bits, unrolled
+BINARY_LIMIT = 1024.0
+_TWO_600 = 2.0 ** 600  # exact rescaling of a short L + V (nh_dot), as microfacet.half_sum
+_TWO_M600 = 2.0 ** -600
+SMALL_LENGTH_SQ = SMALL_LENGTH * SMALL_LENGTH  # |L + V|² below which nh_dot rescales
+
+
+def lobe_mode(n: float) -> int:
+    """The :func:`lobe_power` mode for exponent *n*: LOBE_INTEGRAL or LOBE_REAL."""
+    n = float(n)
+    return LOBE_INTEGRAL if n < BINARY_LIMIT and n == math.floor(n) else LOBE_REAL
+
+
+@formula
+def _square_step(r, b, q):
+    """One bit of :func:`lobe_pow`'s binary exponentiation: r·b if q is odd, b², ⌊q/2⌋.
+    r·1.0 where the bit is 0 is exact, so the products are lobe_pow's, bit for bit."""
+    h = floor(q * 0.5)
+    return r * select(q - 2.0 * h > 0.5, b, 1.0), b * b, h
+
+
+@formula
+def _binary_power(x, n):
+    """xⁿ for integral 0 ≤ n < 2¹⁰ by ten unrolled squaring steps (:func:`_square_step`)."""
+    r, b, q = _square_step(1.0, x, n)
+    r, b, q = _square_step(r, b, q)
+    r, b, q = _square_step(r, b, q)
+    r, b, q = _square_step(r, b, q)
+    r, b, q = _square_step(r, b, q)
+    r, b, q = _square_step(r, b, q)
+    r, b, q = _square_step(r, b, q)
+    r, b, q = _square_step(r, b, q)
+    r, b, q = _square_step(r, b, q)
+    r, b, q = _square_step(r, b, q)
+    return r
+
+
+@formula
+def lobe_power(x, n, mode):
+    """max(0, x)ⁿ with 0⁰ = 1: :func:`lobe_pow` as a formula, the same values bit for bit.
+
+    *mode* (a compile-time constant): LOBE_INTEGRAL multiplies (:func:`_binary_power`;
+    only for the n :func:`lobe_mode` gives it), LOBE_REAL is ``x ** n``, LOBE_AUTO
+    selects between the two per n (both evaluated; a discarded NaN is harmless).
+    """
+    xp = maximum(x, 0.0)  # clamp: a negative base is the lobe's 0 (selected below)
+    if mode == LOBE_INTEGRAL:
+        r = _binary_power(xp, n)
+    elif mode == LOBE_REAL:
+        r = power(xp, n)
+    else:
+        r = select((n < BINARY_LIMIT) & (n == floor(n)), _binary_power(xp, n), power(xp, n))
+    return select(x > 0.0, r, select(n == 0.0, 1.0, 0.0))
+
+
+@formula
+def rv_dot(ix, iy, iz, ox, oy, oz):
+    """R·V = 2(N·L)(N·V) − L·V (:func:`brdfkit._kern.r_dot_v`, the same operations)."""
+    return 2.0 * iz * oz - (ix * ox + iy * oy + iz * oz)
+
+
+@formula
+def nh_dot(ix, iy, iz, ox, oy, oz):
+    """(N·H, |L + V|) without underflow, branch-free (:func:`brdfkit._kern.n_dot_h`).
+
+    Where |L + V|² < SMALL_LENGTH² (1e-280: both directions within ~1e-140 of the
+    horizon, nearly opposite) the sum is multiplied by 2⁶⁰⁰ first (exact: a power of
+    two; its squares are then normal, ≤ (4e40)²): elsewhere the factor is 1 and the
+    values are n_dot_h's bit for bit. L + V = 0 gives N·H = 0 (n_dot_h's value) and length 0.
+    """
+    sz = iz + oz
+    sx = ix + ox
+    sy = iy + oy
+    small = sx * sx + sy * sy + sz * sz < SMALL_LENGTH_SQ
+    r = select(small, _TWO_600, 1.0)
+    zx = sx * r
+    zy = sy * r
+    zz = sz * r
+    length = sqrt(zx * zx + zy * zy + zz * zz)
+    ok = length > 0.0
+    hz = zz / select(ok, length, 1.0)  # 1.0: L + V = 0, N·H 0 below
+    return select(ok, hz, 0.0), length * select(small, _TWO_M600, 1.0)
+
+
 def lobe_hint(kind: str, n: float) -> Lobe:
     """Lobe hint of a cosⁿ lobe: half-angle β with cosⁿβ = 1/2 (n = 0: constant, diffuse)."""
     if n <= 0.0:
@@ -94,10 +201,66 @@ def channel_mean(x) -> float:
     return float(np.mean(x))
 
 
+_SLOTS = ("cosine", "phong", "blinn")  # the components of lobes_sample, in its order
+_UP = np.array([0.0, 0.0, 1.0])  # a wo for _strategy (the models' weights do not depend on it)
+
+
+def lobe_sampler_args(mixture: Mixture, layout: tuple) -> tuple:
+    """(w_c, w_p, w_b, n_p, n_b) of :func:`~brdfkit.models.sampling.lobes_sample` for
+    *mixture*, whose components are, in order, those *layout* names ("cosine", "phong": the
+    cosⁿ lobe about the mirror of ω_o, "blinn": the N·H lobe; a subsequence of that order,
+    so that the cumulative weights, and with them the pick from u₀, are the mixture's).
+    A lobe of exponent 0 is the cosine (phong_lobe, blinn_lobe): its exponent is 0."""
+    if list(layout) != [s for s in _SLOTS if s in layout] or len(layout) != len(
+            mixture.components):
+        raise ValueError(f"layout {layout!r} is not a subsequence of {_SLOTS} matching "
+                         f"{mixture!r}")
+    w = dict.fromkeys(_SLOTS, 0.0)
+    n = {"phong": 0.0, "blinn": 0.0}
+    for slot, comp, weight in zip(layout, mixture.components, mixture.weights, strict=True):
+        w[slot] = float(weight)
+        if isinstance(comp, CosPowerAxis) and comp.axis is None and slot == "phong":
+            n[slot] = comp.n
+        elif (isinstance(comp, HalfVector) and isinstance(comp.distribution, PowerHalf)
+              and comp.fold and slot == "blinn"):
+            n[slot] = comp.distribution.n
+        elif comp is not COSINE:
+            raise ValueError(f"component {comp!r} is not the {slot} slot of lobes_sample")
+    return w["cosine"], w["phong"], w["blinn"], n["phong"], n["blinn"]
+
+
 class CosineLobeBRDF(StrategySampled, BRDF):
     """Base of the cosⁿ-lobe models: sampled by ``_strategy(wo)`` (see
     :class:`~brdfkit.models.sampling.StrategySampled`); the width parameter is the
-    exponent, converted from a half-angle ``beta`` by cosⁿβ = 1/2."""
+    exponent, converted from a half-angle ``beta`` by cosⁿβ = 1/2.
+
+    A model whose f_r is a formula sets :attr:`lobe_kernels` and :attr:`lobe_layout`:
+    :meth:`eval` then runs the ``"vector"`` loop of the kernel for its exponent
+    (:func:`lobe_mode`), and :meth:`formulas` gives that kernel with
+    :func:`~brdfkit.models.sampling.lobes_sample`/``lobes_pdf`` for its strategy.
+    """
+
+    #: (kernel for any exponent, kernel for integral exponents below 2¹⁰), both formulas of
+    #: (ix, iy, iz, ox, oy, oz, p) (:func:`lobe_power`'s LOBE_AUTO and LOBE_INTEGRAL), or None
+    lobe_kernels: tuple | None = None
+    #: the slots of ``_strategy``'s components in :func:`lobe_sampler_args`
+    lobe_layout: tuple = ()
+
+    def _validate(self):
+        if self.lobe_kernels is not None:
+            self._driver = loop_driver(self._lobe_kernel(), loop="vector")
+
+    def _lobe_kernel(self):
+        any_n, integral = self.lobe_kernels
+        mode = lobe_mode(self._values[self.width_param])
+        return integral if mode == LOBE_INTEGRAL else any_n
+
+    def formulas(self) -> Formulas | None:
+        """The kernel for this exponent, the sampler :func:`lobes_sample` and its pdf."""
+        if self.lobe_kernels is None:
+            return None
+        return Formulas(eval=self._lobe_kernel(), sample=lobes_sample, pdf=lobes_pdf,
+                        args=lobe_sampler_args(self._strategy(_UP), self.lobe_layout))
 
     @classmethod
     def width_from_beta(cls, beta: float) -> float:

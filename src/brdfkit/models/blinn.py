@@ -34,11 +34,14 @@ import math
 import numba
 import numpy as np
 
+from brdfkit._dual import formula, select
 from brdfkit._kern import INV_PI, below_horizon, n_dot_h
-from brdfkit.models._base import Lobe, Param
+from brdfkit.models._base import VECTOR_OPTIONS, Lobe, Param
 from brdfkit.models._lobes import (
     K_D,
     K_S,
+    LOBE_AUTO,
+    LOBE_INTEGRAL,
     N_EXP,
     RHO_D,
     RHO_S,
@@ -46,6 +49,8 @@ from brdfkit.models._lobes import (
     KdKsBlinnBRDF,
     lobe_hint,
     lobe_pow,
+    lobe_power,
+    nh_dot,
 )
 from brdfkit.models._params import packed_indices
 from brdfkit.models._registry import register
@@ -66,11 +71,23 @@ RECIPROCAL_PARAMS = (K_D, K_S, N_EXP)
 P_K_D, P_K_S, P_K_N = packed_indices(RECIPROCAL_PARAMS, "k_d", "k_s", "n")
 
 
-@numba.njit(cache=True)
+@formula
+def phong_blinn_reciprocal(ix, iy, iz, ox, oy, oz, p, mode):
+    """Lewis eq. (24), k_d + k_s (N·H)ⁿ, a formula (:mod:`brdfkit._dual`): branch-free, 0 at
+    and below the horizon; *mode* the compile-time ``lobe_power`` mode."""
+    k_d, k_s, n = p[P_K_D], p[P_K_S], p[P_K_N]
+    nh, _ = nh_dot(ix, iy, iz, ox, oy, oz)
+    return select((iz > 0.0) & (oz > 0.0), k_d + k_s * lobe_power(nh, n, mode), 0.0)
+
+
+@formula(**VECTOR_OPTIONS)
 def _phong_blinn_reciprocal(ix, iy, iz, ox, oy, oz, p):
-    if below_horizon(iz, oz):
-        return 0.0
-    return p[P_K_D] + p[P_K_S] * lobe_pow(n_dot_h(ix, iy, iz, ox, oy, oz), p[P_K_N])
+    return phong_blinn_reciprocal(ix, iy, iz, ox, oy, oz, p, LOBE_AUTO)
+
+
+@formula(**VECTOR_OPTIONS)
+def _phong_blinn_reciprocal_int(ix, iy, iz, ox, oy, oz, p):
+    return phong_blinn_reciprocal(ix, iy, iz, ox, oy, oz, p, LOBE_INTEGRAL)
 
 
 @register
@@ -101,6 +118,8 @@ class PhongBlinnReciprocal(KdKsBlinnBRDF):
     reciprocal = True
     width_param = "n"
     kernel = _phong_blinn_reciprocal
+    lobe_kernels = (_phong_blinn_reciprocal, _phong_blinn_reciprocal_int)
+    lobe_layout = ("cosine", "blinn")
     examples = (
         {},
         {"k_d": 0.0, "k_s": 400.0, "n": 10000.0},
@@ -185,13 +204,27 @@ MODIFIED_BLINN_PARAMS = (RHO_D, RHO_S, N_EXP)
 P_RHO_D, P_RHO_S, P_N = packed_indices(MODIFIED_BLINN_PARAMS, "rho_d", "rho_s", "n")
 
 
-@numba.njit(cache=True)
-def _modified_blinn_phong(ix, iy, iz, ox, oy, oz, p):
-    if below_horizon(iz, oz):
-        return 0.0
+INV_8PI = 1.0 / (8.0 * math.pi)  # the (n+8)/8π of Nielsen eq. (2)
+
+
+@formula
+def modified_blinn_phong(ix, iy, iz, ox, oy, oz, p, mode):
+    """Nielsen eq. (2), a formula (:mod:`brdfkit._dual`): branch-free, 0 at and below the
+    horizon; *mode* the compile-time ``lobe_power`` mode."""
     rho_d, rho_s, n = p[P_RHO_D], p[P_RHO_S], p[P_N]
-    nh = n_dot_h(ix, iy, iz, ox, oy, oz)
-    return rho_d * INV_PI + rho_s * (n + 8.0) * (1.0 / (8.0 * math.pi)) * lobe_pow(nh, n)
+    nh, _ = nh_dot(ix, iy, iz, ox, oy, oz)
+    f = rho_d * INV_PI + rho_s * (n + 8.0) * INV_8PI * lobe_power(nh, n, mode)
+    return select((iz > 0.0) & (oz > 0.0), f, 0.0)
+
+
+@formula(**VECTOR_OPTIONS)
+def _modified_blinn_phong(ix, iy, iz, ox, oy, oz, p):
+    return modified_blinn_phong(ix, iy, iz, ox, oy, oz, p, LOBE_AUTO)
+
+
+@formula(**VECTOR_OPTIONS)
+def _modified_blinn_phong_int(ix, iy, iz, ox, oy, oz, p):
+    return modified_blinn_phong(ix, iy, iz, ox, oy, oz, p, LOBE_INTEGRAL)
 
 
 @register
@@ -232,6 +265,8 @@ class ModifiedBlinnPhong(CosineLobeBRDF):
     reciprocal = True
     width_param = "n"
     kernel = _modified_blinn_phong
+    lobe_kernels = (_modified_blinn_phong, _modified_blinn_phong_int)
+    lobe_layout = ("cosine", "blinn")
     examples = (
         {},
         {"rho_d": 0.0, "rho_s": 1.0, "n": 10000.0},

@@ -29,27 +29,24 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-import numba
 import numpy as np
 
-from brdfkit._kern import (
-    INV_PI,
-    INV_TWO_PI,
-    SMALL_LENGTH,
-    below_horizon,
-    r_dot_v,
-    scaled_length,
-)
-from brdfkit.fresnel import _fresnel_dielectric
-from brdfkit.models._base import Lobe, Param
+from brdfkit._dual import formula, maximum, minimum, select, sqrt
+from brdfkit._kern import INV_PI, INV_TWO_PI
+from brdfkit.models._base import VECTOR_OPTIONS, Lobe, Param
 from brdfkit.models._lobes import (
     COS_DIVISOR_FLOOR,
+    LOBE_AUTO,
+    LOBE_INTEGRAL,
     N_EXP,
     RHO_D,
     CosineLobeBRDF,
     channel_mean,
     lobe_hint,
-    lobe_pow,
+    lobe_mode,
+    lobe_power,
+    nh_dot,
+    rv_dot,
 )
 from brdfkit.models._params import ETA, packed_indices
 from brdfkit.models._registry import register
@@ -70,14 +67,26 @@ NEUMANN_PHONG_PARAMS = (
 P_C_N, P_N = packed_indices(NEUMANN_PHONG_PARAMS, "c_n", "n")
 
 
-@numba.njit(cache=True)
-def _neumann_phong(ix, iy, iz, ox, oy, oz, p):
-    if below_horizon(iz, oz):
-        return 0.0
+@formula
+def neumann_phong(ix, iy, iz, ox, oy, oz, p, mode):
+    """Neumann eq. (22), a formula (:mod:`brdfkit._dual`): branch-free, 0 at and below the
+    horizon; *mode* the compile-time ``lobe_power`` mode. max(N·L, N·V) > 0 above the
+    horizon but can be subnormal (both directions within 1e-300 of the horizon), where
+    c_n/max overflows; floored at COS_DIVISOR_FLOOR (see there)."""
     c_n, n = p[P_C_N], p[P_N]
-    # max(N·L, N·V) > 0 above the horizon but can be subnormal (both directions within
-    # 1e-300 of the horizon), where c_n/max overflows; floored at COS_DIVISOR_FLOOR (see there)
-    return c_n * lobe_pow(r_dot_v(ix, iy, iz, ox, oy, oz), n) / max(iz, oz, COS_DIVISOR_FLOOR)
+    f = (c_n * lobe_power(rv_dot(ix, iy, iz, ox, oy, oz), n, mode)
+         / maximum(maximum(iz, oz), COS_DIVISOR_FLOOR))
+    return select((iz > 0.0) & (oz > 0.0), f, 0.0)
+
+
+@formula(**VECTOR_OPTIONS)
+def _neumann_phong(ix, iy, iz, ox, oy, oz, p):
+    return neumann_phong(ix, iy, iz, ox, oy, oz, p, LOBE_AUTO)
+
+
+@formula(**VECTOR_OPTIONS)
+def _neumann_phong_int(ix, iy, iz, ox, oy, oz, p):
+    return neumann_phong(ix, iy, iz, ox, oy, oz, p, LOBE_INTEGRAL)
 
 
 @register
@@ -121,6 +130,8 @@ class NeumannPhong(CosineLobeBRDF):
     reciprocal = True
     width_param = "n"
     kernel = _neumann_phong
+    lobe_kernels = (_neumann_phong, _neumann_phong_int)
+    lobe_layout = ("phong",)
     examples = (
         {},
         {"n": 5000.0},
@@ -156,33 +167,78 @@ N_RHO_D, N_K_S, N_S, N_ALPHA, N_ETA = packed_indices(
     NIELSEN_PARAMS, "rho_d", "k_s", "s", "alpha", "eta")
 
 
-@numba.njit(cache=True)
-def _nielsen(ix, iy, iz, ox, oy, oz, p):
-    if below_horizon(iz, oz):
-        return 0.0
+@formula
+def fresnel_dielectric(c, eta):
+    """:func:`brdfkit.fresnel.fresnel_dielectric` (its operations) as a branch-free formula:
+    c clamped to [0, 1] (callers pass dot products of unit vectors, which rounding can push
+    just outside), 1 for total internal reflection (g² ≤ 0, only for η < 1)."""
+    c = minimum(maximum(c, 0.0), 1.0)
+    g2 = eta * eta + c * c - 1.0
+    tir = g2 <= 0.0
+    g = sqrt(select(tir, 1.0, g2))  # 1.0: the discarded lane finite
+    gpc = g + c
+    gmc = g - c
+    a = c * gpc - 1.0
+    b = c * gmc + 1.0
+    return select(tir, 1.0, 0.5 * (gmc * gmc) / (gpc * gpc) * (1.0 + (a * a) / (b * b)))
+
+
+@formula
+def nielsen(ix, iy, iz, ox, oy, oz, p, mode, fresnel):
+    """Nielsen eq. (3), a formula (:mod:`brdfkit._dual`): branch-free, 0 at and below the
+    horizon; *mode* the ``lobe_power`` mode, *fresnel* whether η is given (else F = 1),
+    both compile-time constants.
+
+    One square root, one division: ω_h·n = (N·L + N·V)/|L + V|,
+    ω_i·ω_h = (1 + L·V)/|L + V| = |L + V|/2 and ω_r·ω_o = 2(N·L)(N·V) − L·V.
+    |L + V| comes from the components (not √(2 + 2 L·V), which rounds to 0 for
+    grazing opposite directions), rescaled where its squares underflow (``nh_dot``).
+    """
     rho_d, k_s, s, alpha, eta = p[N_RHO_D], p[N_K_S], p[N_S], p[N_ALPHA], p[N_ETA]
-    # One square root, one division: ω_h·n = (N·L + N·V)/|L + V|,
-    # ω_i·ω_h = (1 + L·V)/|L + V| = |L + V|/2 and ω_r·ω_o = 2(N·L)(N·V) − L·V.
-    # |L + V| comes from the components (not √(2 + 2 L·V), which rounds to 0 for
-    # grazing opposite directions).
-    lv = ix * ox + iy * oy + iz * oz
-    sx, sy, sz = ix + ox, iy + oy, iz + oz
-    length = math.sqrt(sx * sx + sy * sy + sz * sz)  # ≥ sz > 0 above the horizon, but:
-    if length < SMALL_LENGTH:
-        # rare: the squares underflowed (grazing, nearly opposite directions); 0 here would
-        # give hz = inf. Scale by the largest component first (brdfkit._kern.half).
-        length = scaled_length(sx, sy, sz)
-        m = max(abs(sx), abs(sy), sz)
-        hz = (sz / m) / (length / m)
+    hz, length = nh_dot(ix, iy, iz, ox, oy, oz)
+    if fresnel:
+        f = fresnel_dielectric(0.5 * length, eta)
     else:
-        hz = sz / length
-    f = 1.0 if eta == 0.0 else _fresnel_dielectric(0.5 * length, eta)  # no eta: F = 1
+        f = 1.0
     hz2 = hz * hz
-    base = (1.0 - alpha) * (2.0 * iz * oz - lv) + alpha * hz2 * hz2
-    # clamp the mixed base at 0 (lobe_pow): R·V < 0 away from the mirror direction can make
-    # it negative, where a non-integer power is undefined and the Phong lobe of eq. (1)
+    base = (1.0 - alpha) * rv_dot(ix, iy, iz, ox, oy, oz) + alpha * hz2 * hz2
+    # the mixed base clamped at 0 (lobe_power): R·V < 0 away from the mirror direction can
+    # make it negative, where a non-integer power is undefined and the Phong lobe of eq. (1)
     # is 0 (max(0, ·), as in Akenine-Möller et al.)
-    return rho_d * INV_PI + k_s * f * lobe_pow(base, s)
+    f = rho_d * INV_PI + k_s * f * lobe_power(base, s, mode)
+    return select((iz > 0.0) & (oz > 0.0), f, 0.0)
+
+
+@formula(**VECTOR_OPTIONS)
+def _nielsen(ix, iy, iz, ox, oy, oz, p):
+    """The class kernel (any s; F where the packed η is not 0, the "not given" value)."""
+    f = nielsen(ix, iy, iz, ox, oy, oz, p, LOBE_AUTO, True)
+    return select(p[N_ETA] == 0.0, nielsen(ix, iy, iz, ox, oy, oz, p, LOBE_AUTO, False), f)
+
+
+@formula(**VECTOR_OPTIONS)
+def _nielsen_any(ix, iy, iz, ox, oy, oz, p):
+    return nielsen(ix, iy, iz, ox, oy, oz, p, LOBE_AUTO, False)
+
+
+@formula(**VECTOR_OPTIONS)
+def _nielsen_any_f(ix, iy, iz, ox, oy, oz, p):
+    return nielsen(ix, iy, iz, ox, oy, oz, p, LOBE_AUTO, True)
+
+
+@formula(**VECTOR_OPTIONS)
+def _nielsen_int(ix, iy, iz, ox, oy, oz, p):
+    return nielsen(ix, iy, iz, ox, oy, oz, p, LOBE_INTEGRAL, False)
+
+
+@formula(**VECTOR_OPTIONS)
+def _nielsen_int_f(ix, iy, iz, ox, oy, oz, p):
+    return nielsen(ix, iy, iz, ox, oy, oz, p, LOBE_INTEGRAL, True)
+
+
+# (integral s, η given) → the kernel (Nielsen._lobe_kernel)
+_NIELSEN_KERNELS = {(False, False): _nielsen_any, (False, True): _nielsen_any_f,
+                    (True, False): _nielsen_int, (True, True): _nielsen_int_f}
 
 
 @register
@@ -225,6 +281,8 @@ class Nielsen(CosineLobeBRDF):
     reciprocal = True
     width_param = "s"
     kernel = _nielsen
+    lobe_kernels = (_nielsen_any, _nielsen_int)  # and with F: _lobe_kernel
+    lobe_layout = ("cosine", "phong", "blinn")
     examples = (
         {"eta": 1.5},
         {"rho_d": 0.0, "k_s": 800.0, "s": 5000.0, "alpha": 0.3},
@@ -241,6 +299,10 @@ class Nielsen(CosineLobeBRDF):
         if v["alpha"] > 0.0:
             out.append(lobe_hint("half", 4.0 * v["s"]))
         return out
+
+    def _lobe_kernel(self):
+        v = self._values
+        return _NIELSEN_KERNELS[(lobe_mode(v["s"]) == LOBE_INTEGRAL, v["eta"] is not None)]
 
     def _strategy(self, wo):
         v = self._values

@@ -57,13 +57,16 @@ import numba
 import numpy as np
 
 from brdfkit._cache import memo
+from brdfkit._dual import formula, maximum, select
 from brdfkit._kern import INV_PI, INV_TWO_PI, below_horizon, n_dot_h, r_dot_v
 from brdfkit.halfangle import beta_from_exponent
-from brdfkit.models._base import Lobe, Param
+from brdfkit.models._base import VECTOR_OPTIONS, Lobe, Param
 from brdfkit.models._lobes import (
     COS_DIVISOR_FLOOR,
     K_D,
     K_S,
+    LOBE_AUTO,
+    LOBE_INTEGRAL,
     N_EXP,
     RHO_D,
     RHO_S,
@@ -72,6 +75,9 @@ from brdfkit.models._lobes import (
     channel_mean,
     lobe_hint,
     lobe_pow,
+    lobe_power,
+    nh_dot,
+    rv_dot,
 )
 from brdfkit.models._params import packed_indices
 from brdfkit.models._registry import register
@@ -144,13 +150,24 @@ MODIFIED_PHONG_PARAMS = (RHO_D, RHO_S, N_EXP)
 P_RHO_D, P_RHO_S, P_N = packed_indices(MODIFIED_PHONG_PARAMS, "rho_d", "rho_s", "n")
 
 
-@numba.njit(cache=True)
-def _modified_phong(ix, iy, iz, ox, oy, oz, p):
-    if below_horizon(iz, oz):
-        return 0.0
+@formula
+def modified_phong(ix, iy, iz, ox, oy, oz, p, mode):
+    """Nielsen eq. (1), a formula (:mod:`brdfkit._dual`): branch-free, 0 at and below the
+    horizon; *mode* the compile-time :func:`~brdfkit.models._lobes.lobe_power` mode."""
     rho_d, rho_s, n = p[P_RHO_D], p[P_RHO_S], p[P_N]
-    cos_r = r_dot_v(ix, iy, iz, ox, oy, oz)  # ω_r·ω_o
-    return rho_d * INV_PI + rho_s * (n + 2.0) * INV_TWO_PI * lobe_pow(cos_r, n)
+    cos_r = rv_dot(ix, iy, iz, ox, oy, oz)  # ω_r·ω_o
+    f = rho_d * INV_PI + rho_s * (n + 2.0) * INV_TWO_PI * lobe_power(cos_r, n, mode)
+    return select((iz > 0.0) & (oz > 0.0), f, 0.0)
+
+
+@formula(**VECTOR_OPTIONS)
+def _modified_phong(ix, iy, iz, ox, oy, oz, p):
+    return modified_phong(ix, iy, iz, ox, oy, oz, p, LOBE_AUTO)
+
+
+@formula(**VECTOR_OPTIONS)
+def _modified_phong_int(ix, iy, iz, ox, oy, oz, p):
+    return modified_phong(ix, iy, iz, ox, oy, oz, p, LOBE_INTEGRAL)
 
 
 @register
@@ -185,6 +202,8 @@ class ModifiedPhong(CosineLobeBRDF):
     has_sampler = True
     width_param = "n"
     kernel = _modified_phong
+    lobe_kernels = (_modified_phong, _modified_phong_int)
+    lobe_layout = ("cosine", "phong")
     examples = (
         {},
         {"rho_d": 0.0, "rho_s": 1.0, "n": 5000.0},
@@ -207,14 +226,38 @@ LEWIS_PARAMS = (K_D, K_S, N_EXP)
 P_K_D, P_K_S, P_K_N = packed_indices(LEWIS_PARAMS, "k_d", "k_s", "n")
 
 
-@numba.njit(cache=True)
-def _phong(ix, iy, iz, ox, oy, oz, p):
-    if below_horizon(iz, oz):
-        return 0.0
+@formula
+def lewis(ix, iy, iz, ox, oy, oz, p, mode, half):
+    """Lewis eq. (8) with F_s^P of eq. (5) (R·V) or, *half*, F_s^B of eq. (6) (N·H), a
+    formula; 0 at and below the horizon. The true f diverges like 1/(N·L) and overflows
+    float64 for N·L < k_s/1.8e308; N·L is floored at COS_DIVISOR_FLOOR (see there)."""
     k_d, k_s, n = p[P_K_D], p[P_K_S], p[P_K_N]
-    # Lewis eq. (8) with F_s^P of eq. (5). The true f diverges like 1/(N·L) and overflows
-    # float64 for N·L < k_s/1.8e308; N·L is floored at COS_DIVISOR_FLOOR (see there)
-    return k_d + k_s * lobe_pow(r_dot_v(ix, iy, iz, ox, oy, oz), n) / max(iz, COS_DIVISOR_FLOOR)
+    if half:
+        c, _ = nh_dot(ix, iy, iz, ox, oy, oz)
+    else:
+        c = rv_dot(ix, iy, iz, ox, oy, oz)
+    f = k_d + k_s * lobe_power(c, n, mode) / maximum(iz, COS_DIVISOR_FLOOR)
+    return select((iz > 0.0) & (oz > 0.0), f, 0.0)
+
+
+@formula(**VECTOR_OPTIONS)
+def _phong(ix, iy, iz, ox, oy, oz, p):
+    return lewis(ix, iy, iz, ox, oy, oz, p, LOBE_AUTO, False)
+
+
+@formula(**VECTOR_OPTIONS)
+def _phong_int(ix, iy, iz, ox, oy, oz, p):
+    return lewis(ix, iy, iz, ox, oy, oz, p, LOBE_INTEGRAL, False)
+
+
+@formula(**VECTOR_OPTIONS)
+def _blinn(ix, iy, iz, ox, oy, oz, p):
+    return lewis(ix, iy, iz, ox, oy, oz, p, LOBE_AUTO, True)
+
+
+@formula(**VECTOR_OPTIONS)
+def _blinn_int(ix, iy, iz, ox, oy, oz, p):
+    return lewis(ix, iy, iz, ox, oy, oz, p, LOBE_INTEGRAL, True)
 
 
 @register
@@ -252,6 +295,8 @@ class Phong(CosineLobeBRDF):
     reciprocal = False
     width_param = "n"
     kernel = _phong
+    lobe_kernels = (_phong, _phong_int)
+    lobe_layout = ("cosine", "phong")
     examples = (
         {},
         {"k_d": 0.0, "k_s": 800.0, "n": 5000.0},
@@ -268,15 +313,6 @@ class Phong(CosineLobeBRDF):
         w = normalised_weights([math.pi * channel_mean(v["k_d"]),
                                 channel_mean(v["k_s"]) * 2.0 * math.pi / (n + 1.0)])
         return Mixture([COSINE, phong_lobe(n)], w)
-
-
-@numba.njit(cache=True)
-def _blinn(ix, iy, iz, ox, oy, oz, p):
-    if below_horizon(iz, oz):
-        return 0.0
-    k_d, k_s, n = p[P_K_D], p[P_K_S], p[P_K_N]
-    # Lewis eq. (8) with F_s^B of eq. (6); N·L floored as in _phong (COS_DIVISOR_FLOOR)
-    return k_d + k_s * lobe_pow(n_dot_h(ix, iy, iz, ox, oy, oz), n) / max(iz, COS_DIVISOR_FLOOR)
 
 
 @register
@@ -310,6 +346,8 @@ class Blinn(KdKsBlinnBRDF):
     reciprocal = False
     width_param = "n"
     kernel = _blinn
+    lobe_kernels = (_blinn, _blinn_int)
+    lobe_layout = ("cosine", "blinn")
     examples = (
         {},
         {"k_d": 0.0, "k_s": 400.0, "n": 10000.0},

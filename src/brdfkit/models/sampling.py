@@ -36,6 +36,12 @@ Random numbers: every strategy reads exactly (u₀, u₁) per sample. A
 weight exceeds u₀) and rescales u₀ to [0, 1) within that component's
 interval, so a mixture consumes the same stream as one strategy.
 
+The same as formulas (:mod:`brdfkit._dual`; Numba and Mitsuba's traced BSDFs):
+:func:`malley` (the cosine), :func:`lobes_sample` and :func:`lobes_pdf` (the mixture
+of the cosine, the cosⁿ lobe about the mirror of ω_o and the N·H lobe that the Phong
+family's models sample: the directions of :class:`Mixture` of :data:`COSINE`,
+:func:`phong_lobe` and :func:`blinn_lobe` for the same (u₀, u₁), and its density).
+
 Lower-level functions (arrays in, arrays out, no validation):
 :func:`sample_phong_lobe`, :func:`pdf_phong_lobe` (cosⁿ about an axis),
 :func:`sample_blinn_lobe`, :func:`pdf_blinn_lobe` (N·H power through the
@@ -60,7 +66,8 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from brdfkit._array import as_directions, as_uniform, stack
-from brdfkit._dual import cos, formula, maximum, sin, sqrt
+from brdfkit._dual import absolute as abs_
+from brdfkit._dual import cos, formula, maximum, minimum, power, select, sin, sqrt
 from brdfkit.geometry import (
     local_to_world,
     pdf_cosine_hemisphere,
@@ -423,6 +430,7 @@ def log_mixture_weights(logw: Sequence[np.ndarray]) -> np.ndarray:
     return w / np.sum(w, axis=-1, keepdims=True)
 
 
+_PI = math.pi
 _TWO_PI = 2.0 * math.pi  # a module constant: formulas read no attributes (brdfkit._dual)
 
 
@@ -434,3 +442,83 @@ def malley(u0, u1):
     r = sqrt(u0)
     phi = _TWO_PI * u1
     return r * cos(phi), r * sin(phi), sqrt(maximum(1.0 - u0, 0.0))  # clamp: rounding at the rim
+
+
+@formula
+def axis_lobe(ax, ay, az, n, u0, u1):
+    """:func:`sample_phong_lobe` as a formula: cos α = u₀^{1/(n+1)} about the unit axis a,
+    in the frame of :func:`brdfkit.geometry.frame_around` (Duff et al. 2017)."""
+    cos_a = power(u0, 1.0 / (n + 1.0))
+    sin_a = sqrt(maximum(0.0, 1.0 - cos_a * cos_a))  # clamp: rounding near cos_a = 1
+    phi = _TWO_PI * u1
+    lx = sin_a * cos(phi)
+    ly = sin_a * sin(phi)
+    sign = select(az >= 0.0, 1.0, -1.0)
+    p = -1.0 / (sign + az)
+    q = ax * ay * p
+    return (lx * (1.0 + sign * ax * ax * p) + ly * q + cos_a * ax,
+            lx * (sign * q) + ly * (sign + ay * ay * p) + cos_a * ay,
+            lx * (-sign * ax) + ly * (-ay) + cos_a * az)
+
+
+@formula
+def _pick(u0, c, w, k):
+    """Component k's share of u₀ in :func:`lobes_sample`: ((u₀ − (c_k − w_k))/w_k, clipped)."""
+    return minimum(maximum((u0 - (c - w)) / select(w > 0.0, w, 1.0), 0.0), 1.0)
+
+
+@formula
+def lobes_sample(ox, oy, oz, u0, u1, w_c, w_p, w_b, n_p, n_b):
+    """ω_i from (u₀, u₁) by :class:`Mixture` ([COSINE, phong_lobe(n_p), blinn_lobe(n_b)],
+    weights (w_c, w_p, w_b)), a formula: the same pick and rescaled u₀ (the first component
+    whose cumulative weight exceeds u₀; a zero-weight pick replaced by the largest weight),
+    the same directions (all three evaluated, one selected; an exponent 0 is the cosine)."""
+    c1 = w_c
+    c2 = c1 + w_p
+    c3 = c2 + w_b
+    k = minimum(select(c1 <= u0, 1.0, 0.0) + select(c2 <= u0, 1.0, 0.0)
+                + select(c3 <= u0, 1.0, 0.0), 2.0)
+    wk = select(k == 0.0, w_c, select(k == 1.0, w_p, w_b))
+    top = select((w_c >= w_p) & (w_c >= w_b), 0.0, select(w_p >= w_b, 1.0, 2.0))  # argmax
+    k = select(wk > 0.0, k, top)
+    ur = select(k == 0.0, _pick(u0, c1, w_c, k),
+                select(k == 1.0, _pick(u0, c2, w_p, k), _pick(u0, c3, w_b, k)))
+    cx, cy, cz = malley(ur, u1)
+    # the cosⁿ lobe about the mirror of ω_o (reflect: (−o_x, −o_y, o_z))
+    px, py, pz = axis_lobe(-ox, -oy, oz, n_p, ur, u1)
+    # the N·H lobe: h about the normal (frame_around(+z) is the identity), ω_i its mirror
+    hx, hy, hz = axis_lobe(0.0, 0.0, 1.0, n_b, ur, u1)
+    d = 2.0 * (ox * hx + oy * hy + oz * hz)
+    bx = d * hx - ox
+    by = d * hy - oy
+    bz = d * hz - oz
+    cos_p = (k == 0.0) | ((k == 1.0) & (n_p == 0.0)) | ((k == 2.0) & (n_b == 0.0))
+    lobe_p = k == 1.0
+    return (select(cos_p, cx, select(lobe_p, px, bx)), select(cos_p, cy, select(lobe_p, py, by)),
+            select(cos_p, cz, select(lobe_p, pz, bz)))
+
+
+@formula
+def lobes_pdf(ix, iy, iz, ox, oy, oz, w_c, w_p, w_b, n_p, n_b):
+    """Density of :func:`lobes_sample` over the sphere (:meth:`Mixture.pdf`, 0 when ω_o is at
+    or below the horizon): w_c cos⁺θ_i/π + w_p (n_p+1)/(2π) max(0, ω_i·R(ω_o))^{n_p}
+    + w_b (n_b+1)/(2π) (N·h)^{n_b}/(4|ω_o·h|), h the upper one of ±(ω_i + ω_o)/|ω_i + ω_o|
+    (:class:`HalfVector`, fold); an exponent 0 is the cosine's density."""
+    p_cos = maximum(iz, 0.0) / _PI  # pdf_cosine_hemisphere's operations
+    p_phong = (n_p + 1.0) / _TWO_PI * power(maximum(-ix * ox - iy * oy + iz * oz, 0.0), n_p)
+    sx = ix + ox
+    sy = iy + oy
+    sz = iz + oz
+    norm = sqrt(sx * sx + sy * sy + sz * sz)
+    ok = norm > 0.0
+    m = select(ok, norm, 1.0) * select(sz < 0.0, -1.0, 1.0)  # the upper h (fold)
+    hx = sx / m
+    hy = sy / m
+    hz = sz / m
+    cos_oh = abs_(ox * hx + oy * hy + oz * hz)
+    ok = ok & (cos_oh > 0.0)
+    p_half = select(ok, (n_b + 1.0) / _TWO_PI * power(maximum(hz, 0.0), n_b)
+                    / (4.0 * select(ok, cos_oh, 1.0)), 0.0)
+    p = (w_c * p_cos + w_p * select(n_p == 0.0, p_cos, p_phong)
+         + w_b * select(n_b == 0.0, p_cos, p_half))
+    return select(oz > 0.0, p, 0.0)
