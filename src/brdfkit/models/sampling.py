@@ -60,7 +60,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from brdfkit._array import as_directions, as_uniform, stack
-from brdfkit._dual import cos, formula, maximum, sin, sqrt
+from brdfkit._dual import cos, formula, maximum, power, select, sin, sqrt
 from brdfkit.geometry import (
     local_to_world,
     pdf_cosine_hemisphere,
@@ -73,7 +73,8 @@ __all__ = [
     "HalfVectorDistribution", "PowerHalf", "Mixture",
     "StrategySampled", "phong_lobe", "blinn_lobe", "sample_phong_lobe", "pdf_phong_lobe",
     "sample_blinn_lobe", "pdf_blinn_lobe", "diffuse_fraction", "split_uniform",
-    "normalised_weights", "log_mixture_weights",
+    "normalised_weights", "log_mixture_weights", "malley", "cos_power_normal_sample",
+    "cos_power_normal_pdf",
 ]
 
 _NORMAL = np.array([0.0, 0.0, 1.0])
@@ -434,3 +435,23 @@ def malley(u0, u1):
     r = sqrt(u0)
     phi = _TWO_PI * u1
     return r * cos(phi), r * sin(phi), sqrt(maximum(1.0 - u0, 0.0))  # clamp: rounding at the rim
+
+
+
+@formula
+def cos_power_normal_sample(ox, oy, oz, u0, u1, q):
+    """:class:`CosPowerNormal` ``(q)`` as a formula: cos θ_i = u₀^{1/(q+1)}, φ = 2πu₁ (the same
+    directions as its ``sample``)."""
+    cos_t = power(u0, 1.0 / (q + 1.0))
+    sin_t = sqrt(maximum(0.0, 1.0 - cos_t * cos_t))  # clamp: rounding at cos_t = 1
+    phi = _TWO_PI * u1
+    return sin_t * cos(phi), sin_t * sin(phi), cos_t
+
+
+@formula
+def cos_power_normal_pdf(ix, iy, iz, ox, oy, oz, q):
+    """Its density (q+1)/(2π) cos^q θ_i for θ_i < 90°, else 0; 0 when ω_o is at or below the
+    horizon (:class:`StrategySampled`)."""
+    up = iz > 0.0
+    p = (q + 1.0) / _TWO_PI * power(select(up, iz, 1.0), q)  # 1: the discarded lane finite
+    return select(up & (oz > 0.0), p, 0.0)
