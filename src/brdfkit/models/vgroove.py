@@ -444,8 +444,10 @@ def cook_torrance(ix, iy, iz, ox, oy, oz, p, fresnel):
     ok = live & (e >= EXPONENT_FLOOR)  # false for NaN (0/0 at the horizon)
     # clamp: e ≤ 0 but for the rounding of hz just above 1
     d = exp_nonpos(minimum(select(ok, e, -1000.0), 0.0)) / (FOUR_PI * m * m * c2 * c2)
-    r = select(small, _TWO_600, 1.0)  # undo the rescaling of s in 4 s_z (N·V)/|s|²
-    g = minimum(1.0, 4.0 * sz * minimum(iz, oz) / l2 * r)  # V-groove G, eq. (10)
+    # V-groove G, eq. (10); a rescaled s: 4 (s_z/|s|²)(N·V) 2^600 (s_z/|s|² first: s_z (N·V)
+    # would underflow), the common path as the kernel always wrote it
+    grazing = 4.0 * (sz / l2) * minimum(iz, oz) * _TWO_600
+    g = minimum(1.0, select(small, grazing, 4.0 * sz * minimum(iz, oz) / l2))
     if fresnel:
         f = fresnel_dielectric(cos_d_of(l2, small), eta)
     else:
