@@ -16,8 +16,8 @@ constant environment L_a = 0.2, ``path`` integrator with max_depth 2, S×S pixel
   Mitsuba's kernel, symbolic mode: the bridge's route for this model;
 - ``bridge microfacet GGX (wavefront route)``: the same model with ``route="wavefront"``
   (NumPy/Numba on every wavefront), for comparison;
-- ``bridge diffuse`` (wavefront route: ``diffuse`` has no formulas) and Mitsuba's
-  ``diffuse`` (ρ = 0.5): the cheapest pair;
+- ``bridge lambert`` (traced: its formulas, as microfacet's; and with
+  ``route="wavefront"``) and Mitsuba's ``diffuse`` (ρ = 0.5): the cheapest pair;
 
 and in ``llvm_ad_spectral`` a gold-like metal with n(λ), k(λ) on a 16-point grid over
 360-830 nm: Mitsuba's ``roughconductor`` with the grid as ``irregular`` spectra against
@@ -145,13 +145,16 @@ def main() -> None:
         ("bridge microfacet GGX (wavefront route)",
          lambda: mitsuba_bsdf(model, route="wavefront"), True),
         ("diffuse (Mitsuba, symbolic)", lambda: {"type": "diffuse", "reflectance": 0.5}, False),
-        ("bridge diffuse (wavefront route)",
-         lambda: mitsuba_bsdf(brdfkit.model("diffuse", rho_d=0.5)), True),
+        ("bridge lambert (traced)",
+         lambda: mitsuba_bsdf(brdfkit.model("lambert", rho_d=0.5)), False),
+        ("bridge lambert (wavefront route)",
+         lambda: mitsuba_bsdf(brdfkit.model("lambert", rho_d=0.5), route="wavefront"), True),
     ]
     results = time_rows(mi, rows, variant, args)
     report(results, rows, variant, args,
-           pairs=[(rows[0][0], rows[2][0]), (rows[0][0], rows[3][0]), (rows[4][0], rows[5][0])],
-           same=[(rows[2][0], rows[3][0])])
+           pairs=[(rows[0][0], rows[2][0]), (rows[0][0], rows[3][0]), (rows[4][0], rows[5][0]),
+                  (rows[4][0], rows[6][0])],
+           same=[(rows[2][0], rows[3][0]), (rows[5][0], rows[6][0])])
 
     variant = use_variant("llvm_ad_spectral")
     metal, grid = spectral_model("microfacet", GRID, distribution="ggx", alpha=ALPHA,

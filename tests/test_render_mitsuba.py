@@ -531,7 +531,7 @@ def test_traced_microfacet_against_roughconductor_and_numba():
     2007, an external implementation) in llvm_ad_rgb and, with per-wavelength n, k, in
     llvm_ad_spectral; its sample/pdf against the Numba compilation of the same formulas
     (model.sample/pdf: the two compilations must agree to float32 rounding), also for
-    Beckmann; and the route choice (microfacet traced, diffuse not, RGB channels in a
+    Beckmann; and the route choice (microfacet traced, a pumped model not, RGB channels in a
     spectral variant not)."""
     rng = np.random.default_rng(11)
     n = 256
@@ -574,9 +574,13 @@ def test_traced_microfacet_against_roughconductor_and_numba():
     got = np.array(tb.eval(ctx, si, wo))[0]
     np.testing.assert_allclose(got, beck.eval(light, view) * light[:, 2], rtol=1e-4,
                                atol=1e-6 * got.max())
-    assert not mitsuba_bsdf(brdfkit.model("diffuse", rho_d=0.5)).traced
+    # a model without formulas (a pumped one: its kernel is the base's times a table) takes
+    # the wavefront route
+    pumped = pump(brdfkit.model("modified-phong", rho_d=0.2, rho_s=0.5, n=20.0), g="max")
+    assert pumped.formulas() is None
+    assert not mitsuba_bsdf(pumped).traced
     with pytest.raises(brdfkit.errors.ParameterError, match="route='traced' needs"):
-        mitsuba_bsdf(brdfkit.model("diffuse", rho_d=0.5), route="traced")
+        mitsuba_bsdf(pumped, route="traced")
     del ours, tb
     gc.collect()
 

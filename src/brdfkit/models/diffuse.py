@@ -23,34 +23,66 @@ from __future__ import annotations
 
 import math
 
-import numba
-
-from brdfkit._kern import INV_PI, INV_TWO_PI, below_horizon
+from brdfkit._dual import Formulas, exp, formula, maximum, power, select
+from brdfkit._kern import INV_PI, INV_TWO_PI
 from brdfkit.halfangle import (
     beta_from_minnaert_k,
     beta_from_neumann_s,
     minnaert_k_from_beta,
     neumann_s_from_beta,
 )
-from brdfkit.models._base import BRDF, Lobe, Param
+from brdfkit.models._base import BRDF, VECTOR_OPTIONS, Lobe, Param
+from brdfkit.models._drivers import loop_driver
 from brdfkit.models._params import DIFFUSE_ALBEDO, packed_indices
 from brdfkit.models._registry import register
-from brdfkit.models.sampling import CosPowerNormal, StrategySampled
+from brdfkit.models.rough_diffuse import cosine_pdf, cosine_sample
+from brdfkit.models.sampling import (
+    CosPowerNormal,
+    StrategySampled,
+    cos_power_normal_pdf,
+    cos_power_normal_sample,
+)
+
+
+class _Traced:
+    """The vectorised loop of the class's formula kernel (``kernel``, a formula of
+    :mod:`brdfkit._dual`) and its formulas for the Mitsuba bridge: the kernel, and the
+    sampler of ``_formula_sampler`` (cosine by default)."""
+
+    def _validate(self):
+        super()._validate()
+        self._driver = loop_driver(type(self).kernel, loop="vector")
+
+    def _formula_sampler(self) -> tuple:
+        return cosine_sample, cosine_pdf, ()
+
+    def formulas(self) -> Formulas:
+        sample, pdf, args = self._formula_sampler()
+        return Formulas(eval=type(self).kernel, sample=sample, pdf=pdf, args=args)
+
+
+class _CosPowerTraced(_Traced):
+    """:class:`_Traced` sampled by ``CosPowerNormal(q)`` (``_cos_power_q``), as formulas."""
+
+    def _strategy(self, wo):
+        return CosPowerNormal(self._cos_power_q())
+
+    def _formula_sampler(self) -> tuple:
+        return cos_power_normal_sample, cos_power_normal_pdf, (self._cos_power_q(),)
 
 LAMBERT_PARAMS = (DIFFUSE_ALBEDO,)
 (P_RHO_D,) = packed_indices(LAMBERT_PARAMS, "rho_d")
 
 
-@numba.njit(cache=True)
+@formula(**VECTOR_OPTIONS)
 def _lambert(ix, iy, iz, ox, oy, oz, p):
-    if below_horizon(iz, oz):
-        return 0.0
+    """ρ_d/π above the horizon, 0 at and below it (a formula: :mod:`brdfkit._dual`)."""
     rho_d = p[P_RHO_D]
-    return rho_d * INV_PI
+    return select((iz > 0.0) & (oz > 0.0), rho_d * INV_PI, 0.0)
 
 
 @register
-class Lambert(BRDF):
+class Lambert(_Traced, BRDF):
     """Lambertian diffuse reflector, f_r = ρ_d/π.
 
     ========  =======  ======  ==========================================
@@ -80,19 +112,20 @@ NEUMANN_NEUMANN_PARAMS = (
 P_B_N, P_S = packed_indices(NEUMANN_NEUMANN_PARAMS, "b_N", "s")
 
 
-@numba.njit(cache=True)
+@formula(**VECTOR_OPTIONS)
 def _neumann_neumann(ix, iy, iz, ox, oy, oz, p):
-    if below_horizon(iz, oz):
-        return 0.0
+    """b_N exp{−s(1/(N·S) + 1/(N·V) − 2)} (Lewis §3.3), 0 at and below the horizon; a
+    formula (:mod:`brdfkit._dual`)."""
     b_n, s = p[P_B_N], p[P_S]
-    if s == 0.0:
-        return b_n  # the lacquer is clear: a Lambertian b_N (avoids 0 * inf below)
+    live = (iz > 0.0) & (oz > 0.0)
     # 1/iz overflows to inf only for subnormal iz; exp(-inf) = 0 is then the right limit.
-    return b_n * math.exp(-s * (1.0 / iz + 1.0 / oz - 2.0))
+    lacquer = b_n * exp(-s * (1.0 / iz + 1.0 / oz - 2.0))
+    # s = 0: the lacquer is clear, a Lambertian b_N (avoids 0 * inf above)
+    return select(live, select(s == 0.0, b_n, lacquer), 0.0)
 
 
 @register
-class NeumannNeumann(StrategySampled, BRDF):
+class NeumannNeumann(_CosPowerTraced, StrategySampled, BRDF):
     """Neumann–Neumann "lacquer" model as written by Lewis §3.3.
 
     f_r(S, V) = b_N exp{−s (1/(N·S) + 1/(N·V) − 2)}: a diffuse base under an
@@ -148,8 +181,8 @@ class NeumannNeumann(StrategySampled, BRDF):
         s = float(self._values["s"])
         return [Lobe("normal", beta_from_neumann_s(s) if s > 0.0 else math.pi / 2)]
 
-    def _strategy(self, wo):
-        return CosPowerNormal(float(self._values["s"]) + 1.0)
+    def _cos_power_q(self) -> float:
+        return float(self._values["s"]) + 1.0
 
 
 # --------------------------------------------------------------------------- Minnaert
@@ -162,12 +195,12 @@ class NeumannNeumann(StrategySampled, BRDF):
 COS_FLOOR = 1e-150
 
 
-@numba.njit(cache=True)
+@formula
 def _minnaert_core(iz, oz, k):
+    """((N·S)(N·V))^{k−1} as two powers (no underflow of the product), 1 for k = 1."""
     e = k - 1.0
-    if e == 0.0:
-        return 1.0
-    return max(iz, COS_FLOOR) ** e * max(oz, COS_FLOOR) ** e  # floor: see COS_FLOOR
+    lobe = power(maximum(iz, COS_FLOOR), e) * power(maximum(oz, COS_FLOOR), e)  # see COS_FLOOR
+    return select(e == 0.0, 1.0, lobe)
 
 
 K_MINNAERT = Param("k", 2.0, 0.0, 1e7, "",
@@ -187,20 +220,20 @@ MINNAERT_EC_PARAMS = (
 P_K_RHO, P_EC_K = packed_indices(MINNAERT_EC_PARAMS, "k_rho", "k")
 
 
-@numba.njit(cache=True)
+@formula(**VECTOR_OPTIONS)
 def _minnaert(ix, iy, iz, ox, oy, oz, p):
-    if below_horizon(iz, oz):
-        return 0.0
+    """b_M ((N·S)(N·V))^{k−1} (Lewis §3.4), 0 at and below the horizon; a formula."""
     b_m, k = p[P_B_M], p[P_K]
-    return b_m * _minnaert_core(iz, oz, k)
+    return select((iz > 0.0) & (oz > 0.0), b_m * _minnaert_core(iz, oz, k), 0.0)
 
 
-@numba.njit(cache=True)
+@formula(**VECTOR_OPTIONS)
 def _minnaert_ec(ix, iy, iz, ox, oy, oz, p):
-    if below_horizon(iz, oz):
-        return 0.0
+    """k_ρ (k+1)/(2π) ((N·S)(N·V))^{k−1} (Lewis §4.3), 0 at and below the horizon; a
+    formula."""
     k_rho, k = p[P_K_RHO], p[P_EC_K]
-    return k_rho * (k + 1.0) * INV_TWO_PI * _minnaert_core(iz, oz, k)
+    f = k_rho * (k + 1.0) * INV_TWO_PI * _minnaert_core(iz, oz, k)
+    return select((iz > 0.0) & (oz > 0.0), f, 0.0)
 
 
 def _minnaert_lobes(k: float) -> list:
@@ -208,7 +241,7 @@ def _minnaert_lobes(k: float) -> list:
 
 
 @register
-class Minnaert(StrategySampled, BRDF):
+class Minnaert(_CosPowerTraced, StrategySampled, BRDF):
     """Minnaert's lunar shader as a BRDF (Lewis §3.4).
 
     f_r(S, V) = b_M ((N·S)(N·V))^{k−1}, from L_r = b_M (N·S)^k (N·V)^{k−1} L_i
@@ -254,13 +287,13 @@ class Minnaert(StrategySampled, BRDF):
     def lobes(self):
         return _minnaert_lobes(float(self._values["k"]))
 
-    def _strategy(self, wo):
+    def _cos_power_q(self) -> float:
         # exact: f cos θ_i ∝ cos^k θ_i for fixed wo, so f cos θ_i / pdf does not depend on wi
-        return CosPowerNormal(float(self._values["k"]))
+        return float(self._values["k"])
 
 
 @register
-class MinnaertEnergyConserving(StrategySampled, BRDF):
+class MinnaertEnergyConserving(_CosPowerTraced, StrategySampled, BRDF):
     """Energy-normalised Minnaert shader (Lewis §4.3).
 
     f_r(S, V) = k_ρ (k+1)/(2π) ((N·S)(N·V))^{k−1}.
@@ -308,6 +341,6 @@ class MinnaertEnergyConserving(StrategySampled, BRDF):
     def lobes(self):
         return _minnaert_lobes(float(self._values["k"]))
 
-    def _strategy(self, wo):
+    def _cos_power_q(self) -> float:
         # exact: f cos θ_i ∝ cos^k θ_i for fixed wo, so f cos θ_i / pdf does not depend on wi
-        return CosPowerNormal(float(self._values["k"]))
+        return float(self._values["k"])

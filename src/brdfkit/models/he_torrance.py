@@ -268,6 +268,10 @@ class HeTorrance(_HalfVectorSampling, BRDF):
     reciprocal = True
     has_sampler = True
     kernel = _he_torrance
+    #: why :meth:`formulas` is None (the Mitsuba bridge's wavefront route, which renders the
+    #: directional-diffuse kernel and warns that the delta spike is not rendered)
+    wavefront_reason = ("the series of D and the effective roughness σ (an iterative root) "
+                        "are loops of data-dependent length: not a branch-free formula")
     examples = (
         {},
         {"sigma0": 0.02, "tau": 10.0},

@@ -117,6 +117,9 @@ class Lafortune(CosineLobeBRDF):
     reciprocal = True
     width_param = "n"
     kernel = _lafortune
+    #: why :meth:`formulas` is None (the Mitsuba bridge's wavefront route)
+    wavefront_reason = ("a variable number of lobes (a loop over them) and a per-ω_o mixture "
+                        "of as many samplers: not a branch-free formula")
     # (C_xy, C_z) → t·(C_xy, C_z), ρ_s → ρ_s / tⁿ leaves the first lobe and the others
     # unchanged: a fit holds C_z of the first lobe (at its given value, default 1: the
     # scale goes into ρ_s, the direction into C_xy / C_z)

@@ -80,7 +80,8 @@ __all__ = [
     "HalfVectorDistribution", "PowerHalf", "Mixture",
     "StrategySampled", "phong_lobe", "blinn_lobe", "sample_phong_lobe", "pdf_phong_lobe",
     "sample_blinn_lobe", "pdf_blinn_lobe", "diffuse_fraction", "split_uniform",
-    "normalised_weights", "log_mixture_weights",
+    "normalised_weights", "log_mixture_weights", "malley", "cos_power_normal_sample",
+    "cos_power_normal_pdf",
 ]
 
 _NORMAL = np.array([0.0, 0.0, 1.0])
@@ -522,3 +523,23 @@ def lobes_pdf(ix, iy, iz, ox, oy, oz, w_c, w_p, w_b, n_p, n_b):
     p = (w_c * p_cos + w_p * select(n_p == 0.0, p_cos, p_phong)
          + w_b * select(n_b == 0.0, p_cos, p_half))
     return select(oz > 0.0, p, 0.0)
+
+
+
+@formula
+def cos_power_normal_sample(ox, oy, oz, u0, u1, q):
+    """:class:`CosPowerNormal` ``(q)`` as a formula: cos θ_i = u₀^{1/(q+1)}, φ = 2πu₁ (the same
+    directions as its ``sample``)."""
+    cos_t = power(u0, 1.0 / (q + 1.0))
+    sin_t = sqrt(maximum(0.0, 1.0 - cos_t * cos_t))  # clamp: rounding at cos_t = 1
+    phi = _TWO_PI * u1
+    return sin_t * cos(phi), sin_t * sin(phi), cos_t
+
+
+@formula
+def cos_power_normal_pdf(ix, iy, iz, ox, oy, oz, q):
+    """Its density (q+1)/(2π) cos^q θ_i for θ_i < 90°, else 0; 0 when ω_o is at or below the
+    horizon (:class:`StrategySampled`)."""
+    up = iz > 0.0
+    p = (q + 1.0) / _TWO_PI * power(select(up, iz, 1.0), q)  # 1: the discarded lane finite
+    return select(up & (oz > 0.0), p, 0.0)

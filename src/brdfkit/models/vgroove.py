@@ -24,9 +24,19 @@ import math
 
 import numba
 
-from brdfkit._kern import SMALL_LENGTH, below_horizon, half, pos_pow
+from brdfkit._dual import (
+    Formulas,
+    acos,
+    exp,
+    exp_nonpos,
+    formula,
+    maximum,
+    minimum,
+    power,
+    select,
+    sqrt,
+)
 from brdfkit.errors import ParameterError
-from brdfkit.fresnel import _fresnel_dielectric
 from brdfkit.halfangle import (
     beckmann_m_from_beta,
     beta_from_beckmann_m,
@@ -37,16 +47,25 @@ from brdfkit.halfangle import (
     trowbridge_reitz_c_from_beta,
 )
 from brdfkit.models._base import BRDF, VECTOR_OPTIONS, Lobe, Param, _check_beta
+from brdfkit.models._drivers import loop_driver
 from brdfkit.models._params import ETA_DIELECTRIC, M_SLOPE, eta_fresnel_split, packed_indices
 from brdfkit.models._registry import register
-from brdfkit.models.microfacet_distributions import _HalfVectorSampling, beckmann_lobe
+from brdfkit.models.microfacet import (
+    _pdf_beckmann,
+    _pdf_ggx,
+    _sample_beckmann,
+    _sample_ggx,
+    cos_d_of,
+    half_sum,
+    reflection_jacobian,
+)
+from brdfkit.models.microfacet_distributions import _HalfVectorSampling
+from brdfkit.models.sampling import cos_power_normal_sample
 
 __all__ = ["TorranceSparrow", "CookTorrance", "g_vgroove", "DENOM_FLOOR", "TS_PARAMS",
            "CT_PARAMS"]
 
 _jit = numba.njit(cache=True, inline="always")
-# Compile options of the fast kernels: as VECTOR_OPTIONS (IEEE division, no fastmath).
-_FAST = VECTOR_OPTIONS["fastmath"]
 
 
 # =========================================================================== shared
@@ -90,29 +109,137 @@ TS_DIST, TS_B, TS_N, TS_C, TS_M, TS_ETA = packed_indices(
     TS_PARAMS, "distribution", "b", "n", "c", "m", "eta")
 
 
-@numba.njit(cache=True)
-def _torrance_sparrow(ix, iy, iz, ox, oy, oz, p):
-    if below_horizon(iz, oz):
-        return 0.0
-    dist, b, n, c, m, eta = p[TS_DIST], p[TS_B], p[TS_N], p[TS_C], p[TS_M], p[TS_ETA]
-    hx, hy, hz, length = half(ix, iy, iz, ox, oy, oz)
+@formula
+def torrance_sparrow(ix, iy, iz, ox, oy, oz, p, dist, fresnel):
+    """F G D/(π (N·S)(N·V)), Lewis eq. (10) with D₁–D₄ and the V-groove G of §3.2; a formula
+    (:mod:`brdfkit._dual`; *dist* and *fresnel* compile-time constants, F = 1 without η).
+
+    H = s/|s| with s = ω_i + ω_o (:func:`~brdfkit.models.microfacet.half_sum`, rescaled
+    when short: H is scale-invariant). 0 at and below the horizon.
+    """
+    b, n, c, m, eta = p[TS_B], p[TS_N], p[TS_C], p[TS_M], p[TS_ETA]
+    live = (iz > 0.0) & (oz > 0.0)
+    sx, sy, sz, small = half_sum(ix, iy, iz, ox, oy, oz)
+    length = sqrt(select(live, sx * sx + sy * sy + sz * sz, 1.0))  # 1: discarded lanes finite
+    hx = sx / length
+    hy = sy / length
+    hz = sz / length
     cos_vh = ox * hx + oy * hy + oz * hz  # = L·H
     if dist == PHONG_D:
-        d = b * pos_pow(hz, n)  # D₁ = b cos^{c₁} α
+        d = b * power(hz, n)  # D₁ = b cos^{c₁} α (h_z > 0 above the horizon; 0⁰ = 1)
     elif dist == GAUSSIAN_D:
-        alpha = math.acos(min(hz, 1.0))  # clamp: rounding can give hz slightly > 1
-        d = b * math.exp(-(c * alpha) ** 2)  # D₂
+        t = c * acos(minimum(hz, 1.0))  # clamp: rounding can give hz slightly > 1
+        d = b * exp(-(t * t))  # D₂
     elif dist == TR_D:
         # D₃; the denominator is ≥ min(c², 1) > 0 unless c² underflows (c < 1e-154) at the
         # exact bisector, where q = 1 is the limit (D₃ peaks at b for every c)
         den = hz * hz * (c * c - 1.0) + 1.0
-        q = c * c / den if den > 0.0 else 1.0
+        q = select(den > 0.0, c * c / select(den > 0.0, den, 1.0), 1.0)
         d = b * q * q
     else:
-        d = 0.25 * beckmann_lobe(hz, m) / (m * m)  # D₄ = e^{−tan²α/m²}/(4m² cos⁴α), no b
-    g = g_vgroove(hz, iz, oz, cos_vh)
-    f = 1.0 if eta == 0.0 else _fresnel_dielectric(cos_vh, eta)  # eta not given: F = 1
-    return f * g * d / (math.pi * max(iz * oz, DENOM_FLOOR))  # floor: see DENOM_FLOOR
+        # D₄ = e^{−tan²α/m²}/(4m² cos⁴α), no b; 0 where tan²α/m² > 700 (as beckmann_lobe)
+        c2 = hz * hz
+        ok = c2 * 700.0 * m * m >= 1.0 - c2
+        e = -(1.0 - c2) / (c2 * m * m)
+        # clamp: e ≤ 0 but for the rounding of hz just above 1
+        d = select(ok, 0.25 * (exp(minimum(select(ok, e, -1000.0), 0.0)) / (c2 * c2))
+                   / (m * m), 0.0)
+    # V-groove G (g_vgroove): 0 where V·H ≤ 0 (L = −V: no bisector)
+    vh = select(cos_vh > 0.0, cos_vh, 1.0)
+    g = select(cos_vh > 0.0, minimum(1.0, minimum(2.0 * hz * oz / vh, 2.0 * hz * iz / vh)), 0.0)
+    if fresnel:
+        f = fresnel_dielectric(cos_vh, eta)
+    else:
+        f = 1.0
+    return select(live, f * g * d / (PI * maximum(iz * oz, DENOM_FLOOR)), 0.0)  # floor: DENOM_FLOOR
+
+
+@formula(**VECTOR_OPTIONS)
+def _ts_phong(ix, iy, iz, ox, oy, oz, p):
+    return torrance_sparrow(ix, iy, iz, ox, oy, oz, p, PHONG_D, False)
+
+
+@formula(**VECTOR_OPTIONS)
+def _ts_phong_f(ix, iy, iz, ox, oy, oz, p):
+    return torrance_sparrow(ix, iy, iz, ox, oy, oz, p, PHONG_D, True)
+
+
+@formula(**VECTOR_OPTIONS)
+def _ts_gaussian(ix, iy, iz, ox, oy, oz, p):
+    return torrance_sparrow(ix, iy, iz, ox, oy, oz, p, GAUSSIAN_D, False)
+
+
+@formula(**VECTOR_OPTIONS)
+def _ts_gaussian_f(ix, iy, iz, ox, oy, oz, p):
+    return torrance_sparrow(ix, iy, iz, ox, oy, oz, p, GAUSSIAN_D, True)
+
+
+@formula(**VECTOR_OPTIONS)
+def _ts_tr(ix, iy, iz, ox, oy, oz, p):
+    return torrance_sparrow(ix, iy, iz, ox, oy, oz, p, TR_D, False)
+
+
+@formula(**VECTOR_OPTIONS)
+def _ts_tr_f(ix, iy, iz, ox, oy, oz, p):
+    return torrance_sparrow(ix, iy, iz, ox, oy, oz, p, TR_D, True)
+
+
+@formula(**VECTOR_OPTIONS)
+def _ts_beckmann(ix, iy, iz, ox, oy, oz, p):
+    return torrance_sparrow(ix, iy, iz, ox, oy, oz, p, BECKMANN_D, False)
+
+
+@formula(**VECTOR_OPTIONS)
+def _ts_beckmann_f(ix, iy, iz, ox, oy, oz, p):
+    return torrance_sparrow(ix, iy, iz, ox, oy, oz, p, BECKMANN_D, True)
+
+
+#: (packed distribution, η given) → the formula kernel
+_TS_KERNELS = {(PHONG_D, False): _ts_phong, (PHONG_D, True): _ts_phong_f,
+               (GAUSSIAN_D, False): _ts_gaussian, (GAUSSIAN_D, True): _ts_gaussian_f,
+               (TR_D, False): _ts_tr, (TR_D, True): _ts_tr_f,
+               (BECKMANN_D, False): _ts_beckmann, (BECKMANN_D, True): _ts_beckmann_f}
+
+
+@numba.njit(cache=True, **VECTOR_OPTIONS)
+def _torrance_sparrow(ix, iy, iz, ox, oy, oz, p):
+    """The model's kernel for callers with one kernel per model (albedo engine, pumping):
+    dispatches on the packed distribution and on whether η is given (0: F = 1)."""
+    dist, fres = p[TS_DIST], p[TS_ETA] != 0.0
+    if dist == PHONG_D:
+        if fres:
+            return _ts_phong_f(ix, iy, iz, ox, oy, oz, p)
+        return _ts_phong(ix, iy, iz, ox, oy, oz, p)
+    if dist == GAUSSIAN_D:
+        if fres:
+            return _ts_gaussian_f(ix, iy, iz, ox, oy, oz, p)
+        return _ts_gaussian(ix, iy, iz, ox, oy, oz, p)
+    if dist == TR_D:
+        if fres:
+            return _ts_tr_f(ix, iy, iz, ox, oy, oz, p)
+        return _ts_tr(ix, iy, iz, ox, oy, oz, p)
+    if fres:
+        return _ts_beckmann_f(ix, iy, iz, ox, oy, oz, p)
+    return _ts_beckmann(ix, iy, iz, ox, oy, oz, p)
+
+
+@formula
+def power_half_sample(ox, oy, oz, u0, u1, n):
+    """ω_i = 2(ω_o·h)h − ω_o with h from (n+1)/(2π) cosⁿθ_h (``HalfVector(PowerHalf(n))``,
+    :func:`~brdfkit.models.sampling.cos_power_normal_sample`), a formula."""
+    hx, hy, hz = cos_power_normal_sample(ox, oy, oz, u0, u1, n)
+    k = 2.0 * (ox * hx + oy * hy + oz * hz)
+    return k * hx - ox, k * hy - oy, k * hz - oz
+
+
+@formula
+def power_half_pdf(ix, iy, iz, ox, oy, oz, n):
+    """Density of :func:`power_half_sample`: (n+1)/(2π) cosⁿθ_h/(4|ω_o·h|), h not folded
+    (``fold=False``); 0 when ω_o is at or below the horizon."""
+    hx, hy, hz, ok, jac = reflection_jacobian(ix, iy, iz, ox, oy, oz)
+    up = hz > 0.0
+    ph = (n + 1.0) / TWO_PI * power(select(up, hz, 1.0), n)  # 1: the discarded lane finite
+    return select(ok & up, ph / jac, 0.0)
 
 
 @register
@@ -195,6 +322,7 @@ class TorranceSparrow(_HalfVectorSampling, BRDF):
             raise ParameterError(
                 f"{self.name}: with distribution 'trowbridge-reitz' parameter 'c' (c3) must lie "
                 f"in (0, 1] (D3 peaks at the normal only then); got {v['c']:g}")
+        self._validate_kernel()
 
     @classmethod
     def width_from_beta(cls, beta: float) -> float:
@@ -205,6 +333,23 @@ class TorranceSparrow(_HalfVectorSampling, BRDF):
         d = super().describe()
         d["beta"] = "n (phong), c (gaussian, trowbridge-reitz) or m (beckmann)"
         return d
+
+    def _validate_kernel(self):
+        v = self._values
+        key = (_TS_DISTRIBUTIONS.index(v["distribution"]), v["eta"] is not None)
+        self._driver = loop_driver(_TS_KERNELS[key], loop="vector")
+        return _TS_KERNELS[key]
+
+    def formulas(self) -> Formulas:
+        """:func:`torrance_sparrow` (this instance's D and Fresnel) and the half-vector
+        sampler of ``_half_lobe``: cosⁿ (phong), Beckmann or GGX (Walter eqs. 28, 35)."""
+        kind, width = self._half_lobe()
+        v = self._values
+        kernel = _TS_KERNELS[(_TS_DISTRIBUTIONS.index(v["distribution"]), v["eta"] is not None)]
+        sample, pdf = {"phong": (power_half_sample, power_half_pdf),
+                       "beckmann": (_sample_beckmann, _pdf_beckmann),
+                       "ggx": (_sample_ggx, _pdf_ggx)}[kind]
+        return Formulas(eval=kernel, sample=sample, pdf=pdf, args=(float(width),))
 
     def _half_lobe(self):
         v = self._values
@@ -252,56 +397,81 @@ CT_PARAMS = (
 CT_M, CT_ETA, CT_RHO_S = packed_indices(CT_PARAMS, "m", "eta", "rho_s")
 
 
-@numba.njit(cache=True)
-def _cook_torrance_grazing(iz, oz, sx, sy, sz, m, eta, rho_s):
-    """:func:`_cook_torrance` when s = wi + wo is shorter than SMALL_LENGTH (not inlined).
+PI = math.pi
+TWO_PI = 2.0 * math.pi
+_TWO_600 = 2.0 ** 600  # the exact rescaling of a short s = wi + wo (half_sum)
+#: tan²δ/m² beyond which e^{−tan²δ/m²} < 1e-290 is given as 0 (as beckmann_lobe)
+EXPONENT_FLOOR = -700.0
+FOUR_PI = 4.0 * math.pi
 
-    The squares of the components of s underflow there (cos²δ = s_z²/|s|² would be 0/0,
-    which the kernel returned as 0). Written with s/q, q the largest component: cos δ and
-    tan δ are scale-invariant, |s| = q|s/q| and 4 s_z (N·V)/|s|² = 4 (s_z/q)(N·V)/(q|s/q|²).
+
+@formula
+def fresnel_dielectric(c, eta):
+    """The dielectric Fresnel reflectance of :func:`brdfkit.fresnel.fresnel_dielectric`
+    (Cook & Torrance 1982 eq. in g, c) as a formula: the same operations, its total internal
+    reflection branch (g² ≤ 0, η < 1) a select."""
+    c = minimum(maximum(c, 0.0), 1.0)  # clamp: a cosine of unit vectors (rounding)
+    g2 = eta * eta + c * c - 1.0
+    tir = g2 <= 0.0
+    g = sqrt(select(tir, 1.0, g2))  # 1: the discarded lane finite
+    gpc = g + c
+    gmc = g - c
+    a = c * gpc - 1.0
+    b = c * gmc + 1.0
+    return select(tir, 1.0, 0.5 * (gmc * gmc) / (gpc * gpc) * (1.0 + (a * a) / (b * b)))
+
+
+@formula
+def cook_torrance(ix, iy, iz, ox, oy, oz, p, fresnel):
+    """ρ_s F D G/((N·L)(N·V)), Neumann et al. eqs. (9)–(10), D = e^{−tan²δ/m²}/(4π m² cos⁴δ);
+    a formula (:mod:`brdfkit._dual`; *fresnel* a compile-time constant: F = 1 without η).
+
+    Written with s = ω_i + ω_o (:func:`~brdfkit.models.microfacet.half_sum`, multiplied by
+    2^600 when both directions are within 1e-140 of the horizon, exact): cos²δ = s_z²/|s|²,
+    L·H = V·H = |s|/2 and, in eq. (10), 2(N·H)(N·V)/(V·H) = 4 s_z (N·V)/|s|² (times 2^600
+    for a rescaled s). 0 at and below the horizon and where tan²δ/m² > 700 (D < 1e-290).
     """
-    q = max(abs(sx), abs(sy), sz)  # ≥ sz > 0 above the horizon
-    a, b, c = sx / q, sy / q, sz / q
-    l2 = a * a + b * b + c * c  # in [1, 3]: no underflow
-    root = math.sqrt(l2)
-    c2 = c * c / l2  # cos²δ
-    e = -(1.0 - c2) / (c2 * m * m)
-    if not e >= -700.0:
-        return 0.0  # D < 1e-290 (see beckmann_lobe)
-    d = math.exp(e) / (4.0 * math.pi * m * m * c2 * c2)
-    g = min(1.0, 4.0 * c * min(iz, oz) / (l2 * q))  # ≤ 4c²/l2 since min(iz, oz) ≤ s_z = c q
-    f = 1.0 if eta == 0.0 else _fresnel_dielectric(0.5 * q * root, eta)
-    return rho_s * f * d * g / max(iz * oz, DENOM_FLOOR)  # floor: see DENOM_FLOOR
-
-
-@numba.njit(cache=True, error_model="numpy", fastmath=_FAST)
-def _cook_torrance(ix, iy, iz, ox, oy, oz, p):
-    if below_horizon(iz, oz):
-        return 0.0
     m, eta, rho_s = p[CT_M], p[CT_ETA], p[CT_RHO_S]
-    # Written with s = wi + wo (five divisions, one square root): cos²δ = s_z²/|s|²,
-    # tan²δ = |s_xy|²/s_z²,
-    # L·H = V·H = |s|/2 (unit vectors) and, in eq. (10), 2(N·H)(N·V)/(V·H) = 4 s_z (N·V)/|s|².
-    sx = ix + ox
-    sy = iy + oy
-    sz = iz + oz  # > 0 above the horizon
-    if sz < SMALL_LENGTH:  # rare: both directions within 1e-140 of the horizon
-        return _cook_torrance_grazing(iz, oz, sx, sy, sz, m, eta, rho_s)
-    sxy2 = sx * sx + sy * sy
-    sz2 = sz * sz
-    l2 = sxy2 + sz2
-    length = math.sqrt(l2)  # |s| ≥ s_z > 0
+    live = (iz > 0.0) & (oz > 0.0)
+    sx, sy, sz, small = half_sum(ix, iy, iz, ox, oy, oz)
+    l2 = select(live, sx * sx + sy * sy + sz * sz, 1.0)  # 1: the discarded lanes finite
+    length = sqrt(l2)
     hz = sz / length
     c2 = hz * hz  # cos²δ
     # −tan²δ/m² rounded exactly as beckmann_lobe (with half()'s N·H): the rounding of the
     # exponent is amplified up to 700× by e^x, and torrance-sparrow's D₄ must agree to 1e-13
     e = -(1.0 - c2) / (c2 * m * m)
-    if not e >= -700.0:
-        return 0.0  # D < 1e-290 (see beckmann_lobe); NaN (0/0 at the horizon): see _beckmann_dgg
-    d = math.exp(e) / (4.0 * math.pi * m * m * c2 * c2)  # e^{−tan²δ/m²}/(4π m² cos⁴δ)
-    g = min(1.0, 4.0 * sz * min(iz, oz) / l2)  # V-groove G, eq. (10) (g_vgroove)
-    f = 1.0 if eta == 0.0 else _fresnel_dielectric(0.5 * length, eta)  # no eta: F = 1
-    return rho_s * f * d * g / max(iz * oz, DENOM_FLOOR)  # floor: see DENOM_FLOOR
+    ok = live & (e >= EXPONENT_FLOOR)  # false for NaN (0/0 at the horizon)
+    # clamp: e ≤ 0 but for the rounding of hz just above 1
+    d = exp_nonpos(minimum(select(ok, e, -1000.0), 0.0)) / (FOUR_PI * m * m * c2 * c2)
+    # V-groove G, eq. (10); a rescaled s: 4 (s_z/|s|²)(N·V) 2^600 (s_z/|s|² first: s_z (N·V)
+    # would underflow), the common path as the kernel always wrote it
+    grazing = 4.0 * (sz / l2) * minimum(iz, oz) * _TWO_600
+    g = minimum(1.0, select(small, grazing, 4.0 * sz * minimum(iz, oz) / l2))
+    if fresnel:
+        f = fresnel_dielectric(cos_d_of(l2, small), eta)
+    else:
+        f = 1.0
+    return select(ok, rho_s * f * d * g / maximum(iz * oz, DENOM_FLOOR), 0.0)  # floor: DENOM_FLOOR
+
+
+@formula(**VECTOR_OPTIONS)
+def _cook_torrance_white(ix, iy, iz, ox, oy, oz, p):
+    return cook_torrance(ix, iy, iz, ox, oy, oz, p, False)
+
+
+@formula(**VECTOR_OPTIONS)
+def _cook_torrance_f(ix, iy, iz, ox, oy, oz, p):
+    return cook_torrance(ix, iy, iz, ox, oy, oz, p, True)
+
+
+@numba.njit(cache=True, **VECTOR_OPTIONS)
+def _cook_torrance(ix, iy, iz, ox, oy, oz, p):
+    """The model's kernel for callers with one kernel per model (albedo engine, pumping):
+    dispatches on whether η is given (0: F = 1)."""
+    if p[CT_ETA] == 0.0:
+        return _cook_torrance_white(ix, iy, iz, ox, oy, oz, p)
+    return _cook_torrance_f(ix, iy, iz, ox, oy, oz, p)
 
 
 @register
@@ -350,6 +520,17 @@ class CookTorrance(_HalfVectorSampling, BRDF):
 
     def _half_lobe(self):
         return "beckmann", float(self._values["m"])
+
+    def _ct_kernel(self):
+        return _cook_torrance_white if self._values["eta"] is None else _cook_torrance_f
+
+    def _validate(self):
+        self._driver = loop_driver(self._ct_kernel(), loop="vector")
+
+    def formulas(self) -> Formulas:
+        """:func:`cook_torrance` and the Beckmann sampler of ``_half_lobe`` (Walter eq. 28)."""
+        return Formulas(eval=self._ct_kernel(), sample=_sample_beckmann, pdf=_pdf_beckmann,
+                        args=(float(self._values["m"]),))
 
     def lobes(self):
         return [Lobe("half", float(beta_from_beckmann_m(self._values["m"])))]

@@ -19,15 +19,18 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
-from brdfkit._kern import INV_PI, below_horizon, half
+from brdfkit._dual import Formulas, exp_nonpos, formula, maximum, minimum, select, sqrt
+from brdfkit._kern import INV_PI
 from brdfkit.halfangle import beta_from_ward_m, ward_m_from_beta
-from brdfkit.models._base import BRDF, Lobe, Param
+from brdfkit.models._base import BRDF, VECTOR_OPTIONS, Lobe, Param
+from brdfkit.models._drivers import loop_driver
 from brdfkit.models._params import M_SLOPE, packed_indices
 from brdfkit.models._registry import register
-from brdfkit.models.microfacet_distributions import _HalfVectorSampling, beckmann_lobe
+from brdfkit.models.microfacet import half_sum, walter_pdf, walter_sample
+from brdfkit.models.microfacet_distributions import _HalfVectorSampling
+from brdfkit.models.sampling import malley
 
 __all__ = ["Ward"]
 
@@ -41,17 +44,58 @@ PARAMS = (
 P_RHO_D, P_RHO_S, P_M = packed_indices(PARAMS, "rho_d", "rho_s", "m")
 
 
-@numba.njit(cache=True)
+FOUR_PI = 4.0 * math.pi
+#: tan²δ/m² beyond which e^{−tan²δ/m²} < 1e-290 is given as 0 (as beckmann_lobe)
+EXPONENT_FLOOR = -700.0
+#: floor of √((N·L)(N·V)): f ≤ ρ_s/(4π m² 1e-140) stays finite when both cosines are
+#: within 1e-280 of the horizon
+ROOT_FLOOR = 1e-140
+
+
+@formula(**VECTOR_OPTIONS)
 def _ward(ix, iy, iz, ox, oy, oz, p):
-    if below_horizon(iz, oz):
-        return 0.0
+    """ρ_d/π + ρ_s e^{−tan²δ/m²}/(4π m² √((N·L)(N·V))), Neumann et al. eq. (8); a formula
+    (:mod:`brdfkit._dual`), 0 at and below the horizon.
+
+    cos δ = s_z/|s| with s = ω_i + ω_o (:func:`~brdfkit.models.microfacet.half_sum`, rescaled
+    when short); e^{−tan²δ/m²} is written as ``beckmann_lobe(cos δ, m) cos⁴δ`` was (the same
+    rounding), 0 where tan²δ/m² > 700.
+    """
     rho_d, rho_s, m = p[P_RHO_D], p[P_RHO_S], p[P_M]
-    hx, hy, hz, length = half(ix, iy, iz, ox, oy, oz)
-    lobe = beckmann_lobe(hz, m) * (hz * hz) * (hz * hz)  # e^{−tan²δ/m²}
-    # sqrt of each cosine separately avoids underflow of the product; the floor
-    # keeps f ≤ ρ_s/(4π m² 1e-140) finite when both are within 1e-280 of the horizon.
-    root = max(math.sqrt(iz) * math.sqrt(oz), 1e-140)
-    return rho_d * INV_PI + rho_s * lobe / (4.0 * math.pi * m * m * root)
+    live = (iz > 0.0) & (oz > 0.0)
+    sx, sy, sz, small = half_sum(ix, iy, iz, ox, oy, oz)
+    l2 = select(live, sx * sx + sy * sy + sz * sz, 1.0)  # 1: the discarded lanes finite
+    hz = sz / sqrt(l2)
+    c2 = hz * hz
+    e = -(1.0 - c2) / (c2 * m * m)
+    up = e >= EXPONENT_FLOOR  # false for NaN (c2 = 0 in a discarded lane)
+    # clamp: e ≤ 0 but for the rounding of hz just above 1
+    lobe = exp_nonpos(minimum(select(up, e, -1000.0), 0.0)) / (c2 * c2) * c2 * c2
+    # sqrt of each cosine separately avoids underflow of the product; floor: ROOT_FLOOR
+    root = maximum(sqrt(maximum(iz, 0.0)) * sqrt(maximum(oz, 0.0)), ROOT_FLOOR)
+    spec = select(up, rho_s * lobe / (FOUR_PI * m * m * root), 0.0)
+    return select(live, rho_d * INV_PI + spec, 0.0)
+
+
+@formula
+def ward_sample(ox, oy, oz, u0, u1, m, w_d):
+    """The sampler of :class:`Ward` (``Mixture([COSINE, HalfVector(Beckmann(m))], [w_d,
+    1 − w_d])``) as a formula: the cosine when u₀ < w_d, else the mirror of ω_o about a
+    Beckmann half vector (Walter eq. 28), u₀ rescaled into its interval (both evaluated)."""
+    pick_cos = u0 < w_d
+    uc = minimum(u0 / maximum(w_d, 1e-30), 1.0)  # floor: w_d = 0 (never picked), clamp: rounding
+    us = maximum((u0 - w_d) / maximum(1.0 - w_d, 1e-30), 0.0)  # floor: w_d = 1 (never picked)
+    cx, cy, cz = malley(uc, u1)
+    x, y, z = walter_sample(ox, oy, oz, us, u1, m, False)
+    return select(pick_cos, cx, x), select(pick_cos, cy, y), select(pick_cos, cz, z)
+
+
+@formula
+def ward_pdf(ix, iy, iz, ox, oy, oz, m, w_d):
+    """Density of :func:`ward_sample`: w_d cos⁺θ_i/π + (1 − w_d) D(h) cos θ_h/(4|ω_o·h|);
+    0 when ω_o is at or below the horizon."""
+    ps = walter_pdf(ix, iy, iz, ox, oy, oz, m, False)
+    return select(oz > 0.0, w_d * maximum(iz, 0.0) * INV_PI + (1.0 - w_d) * ps, 0.0)
 
 
 @register
@@ -102,6 +146,14 @@ class Ward(_HalfVectorSampling, BRDF):
         d = float(np.mean(self._values["rho_d"]))
         s = float(np.mean(self._values["rho_s"]))
         return 0.5 if d + s <= 0.0 else d / (d + s)
+
+    def _validate(self):
+        self._driver = loop_driver(_ward, loop="vector")
+
+    def formulas(self) -> Formulas:
+        """:func:`_ward` and the cosine + Beckmann half-vector mixture of ``_strategy``."""
+        return Formulas(eval=_ward, sample=ward_sample, pdf=ward_pdf,
+                        args=(float(self._values["m"]), self._p_diffuse()))
 
     def lobes(self):
         out = [Lobe("diffuse", math.pi / 2)] if np.any(self._values["rho_d"]) else []
