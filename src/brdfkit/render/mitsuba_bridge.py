@@ -103,15 +103,15 @@ from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
 from brdfkit.render.mitsuba_colour import ColourMap, check_wavelengths
 from brdfkit.render.mitsuba_plugin import register_plugin
-from brdfkit.render.mitsuba_traced import traced_class, traced_supported
+from brdfkit.render.mitsuba_traced import traced_class, wavefront_reason
 from brdfkit.render.mitsuba_variants import FALLBACK, VARIANTS, select_variant
 from brdfkit.render.mitsuba_variants import import_mitsuba as _mitsuba
 from brdfkit.render.mitsuba_wavefront import wavefront, wavefront_class
 from brdfkit.spec import model as build_model
 
-__all__ = ["FALLBACK", "ROUTES", "VARIANTS", "mitsuba_bsdf", "spectral_model", "use_variant",
-           "wavefront", "MAX_LANES", "MAX_SAMPLES", "MITSUBA_MAX_SIZE", "SEED_LIMIT",
-           "check_seed", "check_samples", "render_bounded"]
+__all__ = ["FALLBACK", "ROUTES", "VARIANTS", "WavefrontRouteWarning", "mitsuba_bsdf",
+           "spectral_model", "use_variant", "wavefront", "MAX_LANES", "MAX_SAMPLES",
+           "MITSUBA_MAX_SIZE", "SEED_LIMIT", "check_seed", "check_samples", "render_bounded"]
 
 #: Most paths (pixels x samples per pixel) of one ``mi.render`` call when the image has
 #: fewer pixels; a render with more is split into calls of fewer samples per pixel
@@ -211,16 +211,31 @@ def _make_bsdf(props, model: BRDF, wavelengths, variant: str, route: str):
     if model.has_delta:
         warnings.warn(f"brdfkit: {model.name}'s specular delta term is not rendered "
                       "by the Mitsuba bridge (only its kernel)", RuntimeWarning, stacklevel=3)
-    if route != "wavefront" and traced_supported(model, variant, grid):
+    reason = wavefront_reason(model, variant, grid)
+    if route != "wavefront" and reason is None:
         if variant not in _TRACED:
             _TRACED[variant] = traced_class(mi, dr, variant)
-        return _TRACED[variant](props, model, grid)
+        bsdf = _TRACED[variant](props, model, grid)
+        bsdf.route_reason = None
+        return bsdf
     if route == "traced":
         raise ParameterError(
-            f"route='traced' needs a model with formulas (model.formulas(); {model.name} has "
-            f"{'them' if model.formulas() is not None else 'none'}), an llvm_* variant "
-            f"(got {variant}) and grey, RGB or wavelength-grid channels; use route='auto'")
-    return wavefront_class(variant)(props, model=model, wavelengths=wavelengths)
+            f"route='traced' needs a model with formulas (model.formulas()), an llvm_* "
+            f"variant and grey, RGB or wavelength-grid channels: {reason}; use route='auto'")
+    bsdf = wavefront_class(variant)(props, model=model, wavelengths=wavelengths)
+    if route == "wavefront":
+        bsdf.route_reason = "route='wavefront' asked for"
+        return bsdf
+    bsdf.route_reason = f"{reason}: the wavefront route"
+    if variant.startswith("llvm"):
+        bsdf.route_reason += (", 3-9x slower than traced; render inside "
+                              "brdfkit.render.mitsuba_bridge.wavefront()")
+    warnings.warn(f"brdfkit: {bsdf.route_reason}", WavefrontRouteWarning, stacklevel=3)
+    return bsdf
+
+
+class WavefrontRouteWarning(UserWarning):
+    """A model takes the bridge's wavefront route (the one-line reason: ``route_reason``)."""
 
 
 def mitsuba_bsdf(model: BRDF, *, wavelengths=None, variant: str | None = None,
@@ -252,7 +267,9 @@ def mitsuba_bsdf(model: BRDF, *, wavelengths=None, variant: str | None = None,
         Usable as a value in a scene dict (``"bsdf": mitsuba_bsdf(model)``),
         in ``mi.chi2.BSDFAdapter``-style tests, or directly. Its attribute
         ``traced`` says which route it takes: False means render inside
-        :func:`wavefront` in ``llvm_*`` variants.
+        :func:`wavefront` in ``llvm_*`` variants; ``route_reason`` says why in
+        one line (None when traced), also given as a
+        :class:`WavefrontRouteWarning` when ``route="auto"`` falls back.
     """
     if not isinstance(model, BRDF):
         raise ParameterError(f"model must be a brdfkit model (BRDF); got {type(model)!r}")
