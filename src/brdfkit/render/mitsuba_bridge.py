@@ -4,21 +4,26 @@ Any brdfkit model as a Mitsuba 3 BSDF
 
 The formulas stay written once. Two routes, chosen per model (``route="auto"``):
 
-- **traced** (models whose :meth:`~brdfkit.models.BRDF.formulas` are given;
-  today ``microfacet``, GGX and Beckmann, with or without Fresnel): the
+- **traced** (models whose :meth:`~brdfkit.models.BRDF.formulas` are given:
+  ``microfacet``, user models, pumped models of those with their tables read
+  in the trace, :func:`brdfkit.tables.lookup`): the
   formula functions that Numba compiles for ``model.eval``/``sample``/``pdf``
   (:mod:`brdfkit._dual`) are rebound to Dr.Jit and called from a Python BSDF
   that Dr.Jit traces into Mitsuba's kernel, in its default symbolic mode
   (:mod:`brdfkit.render.mitsuba_traced`). As fast as Mitsuba's own BSDFs.
-- **wavefront** (every other model, the ``scalar_*`` variants, and RGB
-  channels in a spectral variant): Mitsuba calls a Python BSDF with whole
+- **wavefront** (the fallback: a model without formulas, the ``scalar_*``
+  variants, RGB channels in a spectral variant, tables per wavelength; the
+  BSDF's ``route_reason`` and a :class:`WavefrontRouteWarning` say which, in
+  one line): Mitsuba calls a Python BSDF with whole
   wavefronts (arrays of every path's directions) when Dr.Jit's symbolic loops,
   calls and conditionals are switched off (:func:`wavefront`), and the BSDF
   hands those arrays to ``model.eval``, ``model.sample`` and ``model.pdf`` as
   NumPy float64 arrays. Works for anything; 8-9× the time of Mitsuba's
   own BSDF at 256², 16 spp (see *Cost* below).
 
-A BSDF's ``traced`` attribute says which route it takes. The design record
+A BSDF's ``traced`` attribute says which route it takes. In ``*_ad_*`` variants a
+traced BSDF lists the model's parameters by name for ``mi.traverse``
+(:mod:`brdfkit.render.mitsuba_traced`). The design record
 (why, the formula contract) is in ``docs/architecture.md``.
 
 Conventions (where the two libraries meet)

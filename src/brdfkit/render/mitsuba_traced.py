@@ -35,6 +35,17 @@ form of :mod:`brdfkit.user`'s kernels) works unchanged: the index column is the
 channels); on a wavelength grid its index column would be interpolated, so give such
 a model RGB channels only.
 
+Tables and parameters
+---------------------
+A model whose formulas read tables (``Formulas.tables = K``: a pumped model's albedo
+lookups) gets its first K columns as above and the rest as one Dr.Jit array, gathered
+from by :func:`brdfkit.tables.lookup` (:class:`~brdfkit.tables.TableRow`); a table per
+wavelength of a grid is not traced (:func:`wavefront_reason`). ``traverse`` lists the
+model's scalar and grey/RGB colour parameters by name, as Dr.Jit values in the row the
+eval formula reads (differentiable unless the model has tables, which are rebuilt in
+NumPy); ``parameters_changed`` rebuilds the model (``with_params``) and its sampler's
+arguments. Design record: ``docs/architecture.md``, "Tables in the trace".
+
 References
 ----------
 - W. Jakob et al., *Mitsuba 3 renderer*, 2022 (``BSDF`` interface, "Custom
