@@ -174,6 +174,40 @@ def test_pumped_traced_matches_numba_and_samples_the_root(root, g, times):
     gc.collect()
 
 
+@pytest.mark.parametrize("kw", [
+    {"distribution": "ggx", "alpha": 0.5, "eta": [0.2, 0.9, 1.1], "k": [3.9, 2.4, 2.2]},
+    {"alpha": 0.3}], ids=["ggx-conductor-rgb", "beckmann-white"])
+def test_turquin_traced_matches_numba_and_kulla_conty_says_why(kw):
+    """Turquin's compensation (Ẽ read with lookup_w in the trace) against model.eval, the
+    base's sampler; Kulla–Conty (a sampler weighted by Ẽ(ω_o)) falls back with a reason."""
+    variant = _variant("llvm_ad_rgb")
+    if not variant.startswith("llvm"):
+        pytest.skip("no LLVM")
+    base = brdfkit.model("microfacet", **kw)
+    model = brdfkit.compensate(base, "turquin")
+    ours = mitsuba_bsdf(model)
+    assert ours.traced
+    rng = np.random.default_rng(8)
+    n = 512
+    view, light = _hemisphere(rng, n), _hemisphere(rng, n)
+    ctx = mi.BSDFContext()
+    si, wo = _interaction(view), mi.Vector3f(light.T.astype(np.float32))
+    got = np.array(ours.eval(ctx, si, wo)).T
+    want = np.asarray(model.eval(light, view)).reshape(n, -1) * light[:, 2:3]
+    np.testing.assert_allclose(got, np.broadcast_to(want, got.shape), rtol=1e-4,
+                               atol=1e-6 * want.max())
+    plain = np.asarray(base.eval(light, view)).reshape(n, -1) * light[:, 2:3]
+    assert np.abs(got - plain).max() > 1e-2 * plain.max()  # power: the factor is in it
+    np.testing.assert_allclose(np.array(ours.pdf(ctx, si, wo)), base.pdf(light, view),
+                               rtol=1e-4, atol=1e-7)
+    del ours
+    with pytest.warns(WavefrontRouteWarning, match="no formulas"):
+        kc = mitsuba_bsdf(brdfkit.compensate(base, "kulla-conty"))
+    assert not kc.traced
+    del kc
+    gc.collect()
+
+
 @pytest.mark.parametrize("uniform", [False, True], ids=["two-level", "uniform-in-sqrt-mu"])
 def test_lookup_primitive_gathers_what_the_table_holds(uniform):
     """The primitive's Dr.Jit read (through a pumped-like composition's row) against the
