@@ -25,11 +25,12 @@ model's divisor) needs, defined once:
    that reads a table packed into its row calls them; Numba inlines :func:`_lookup`
    / :func:`_lookup_w`, Dr.Jit (the Mitsuba bridge's traced route) runs the same
    cubic read with ``dr.gather`` from the table rows held once as a Dr.Jit array
-   (:class:`TracedTables`, carried by the row a traced formula receives,
-   :class:`TableRow`).
+   (:class:`~brdfkit.traced_tables.TracedTables`, carried by the row a traced
+   formula receives, :class:`~brdfkit.traced_tables.TableRow`;
+   :mod:`brdfkit.traced_tables`).
 
 This is a low layer: it imports NumPy, Numba, :mod:`brdfkit.errors`,
-:mod:`brdfkit._kern` and :mod:`brdfkit._dual` only
+:mod:`brdfkit._kern`, :mod:`brdfkit._dual` and :mod:`brdfkit.traced_tables` only
 (models and engines import it, never the reverse).
 
 Public objects
@@ -41,8 +42,8 @@ Public objects
   single-level table uniform in √μ (4 reads, one square root, for a function smooth
   in √μ: a compensation's E(μ)).
 - :func:`lookup`, :func:`lookup_w` — the two reads as formula primitives (the offset
-  may be a float read from the row); :class:`TracedTables`, :class:`TableRow` — their
-  Dr.Jit side's data.
+  may be a float read from the row); :func:`row_from` — a row's tail, for a formula that
+  wraps another's.
 - :data:`LUT_TOL`, :data:`LUT_CELLS` — the lookup's default tolerance and cells.
 """
 
@@ -58,18 +59,18 @@ import numpy as np
 from brdfkit._dual import primitive
 from brdfkit._kern import clamp_unit, load_input
 from brdfkit.errors import BrdfkitError, ParameterError
+from brdfkit.traced_tables import lookup_drjit, lookup_w_drjit, row_from_drjit
 
 __all__ = [
     "LUT_CELLS",
     "LUT_TOL",
     "Lookup",
-    "TableRow",
-    "TracedTables",
     "UniformLookup",
     "build_lookup",
     "build_uniform_lookup",
     "lookup",
     "lookup_w",
+    "row_from",
     "mu_of_w",
     "theta_of_w",
     "w_of_mu",
@@ -485,108 +486,14 @@ def lookup_w(p, off, mu):  # pragma: no cover - compiled
     return _lookup_w(p, numba.int64(off), mu)
 
 
-class TracedTables:
-    """A model's packed rows from column *start* on, for the Dr.Jit reads of :func:`lookup`.
-
-    The rows (C, W) are held once as one Dr.Jit array of *float_type* (channel c's row at
-    c·W); channels whose table columns are all equal share one row. *combine* turns the
-    per-channel values of a read into the row's colour type (``mi.Color3f`` for three
-    channels; one value is returned as it is). The offsets, cell counts and interval counts
-    of the tables are read in Python (compile-time constants of the trace); the headers
-    and cubics by ``dr.gather``.
-    """
-
-    def __init__(self, rows: np.ndarray, start: int, float_type, combine: Callable):
-        rows = np.atleast_2d(np.asarray(rows, dtype=np.float64))
-        if np.all(rows[:, start:] == rows[:1, start:]):
-            rows = rows[:1]  # one table for every channel
-        self.rows = rows
-        self.start = int(start)
-        self.width = rows.shape[1]
-        self.channels = rows.shape[0]
-        self.float_type = float_type
-        self.data = float_type(np.ascontiguousarray(rows.reshape(-1), dtype=np.float32))
-        self.combine = combine
-
-    def column(self, i: int):
-        """Column *i* (negative: from the end) of every channel: a float when they agree,
-        else a tuple of the channels' values (an offset a lookup reads per channel)."""
-        col = self.rows[:, i]
-        return float(col[0]) if np.all(col == col[0]) else tuple(float(x) for x in col)
-
-    def offset(self, off, c: int) -> int:
-        """Channel *c*'s table offset from *off* (a number, or a tuple of them per channel)."""
-        return int(off[c] if isinstance(off, tuple) else off)
+@numba.njit(cache=True, inline="always")
+def row_from(p, n):  # pragma: no cover - compiled
+    """The row *p* from column *n* on (a view): a formula that passes a model's row on to
+    another model's formula after its own columns (:mod:`brdfkit.render.metals`'s Fresnel
+    weighting). Dr.Jit: the tuple's tail, a :class:`TableRow` keeping its tables."""
+    return p[n:]
 
 
-class TableRow(tuple):
-    """The row a traced formula receives (:mod:`brdfkit.render.mitsuba_traced`): its
-    parameters (columns before the tables' start, floats or colours) as a tuple, and
-    ``tables`` (:class:`TracedTables`) for :func:`lookup`; an index from the tables' start
-    on, or negative (a trailer), reads :meth:`TracedTables.column`."""
-
-    def __new__(cls, params, tables: TracedTables):
-        row = super().__new__(cls, params)
-        row.tables = tables
-        return row
-
-    def __getitem__(self, i):
-        if isinstance(i, int) and not 0 <= i < len(self):
-            return self.tables.column(i)
-        return tuple.__getitem__(self, i)
-
-
-def _unit_drjit(dr, mu):
-    """μ clamped to [0, 1], NaN to 0 (as :func:`brdfkit._kern.clamp_unit`)."""
-    return dr.select(mu >= 0.0, dr.minimum(mu, 1.0), 0.0)
-
-
-def _cubic_drjit(dr, tabs: TracedTables, b, t):
-    """The cubic whose 4 coefficients start at index *b* of ``tabs.data``, at *t*."""
-    c = [dr.gather(tabs.float_type, tabs.data, b + i) for i in range(4)]
-    return ((c[0] * t + c[1]) * t + c[2]) * t + c[3]
-
-
-def _lookup_drjit(dr):
-    def lookup_(p, off, mu):
-        """:func:`_lookup` per channel with gathers (same cells, same cubics)."""
-        tabs = p.tables
-        index = dr.uint32_array_t(tabs.float_type)
-        mu = _unit_drjit(dr, mu)
-        out = []
-        for c in range(tabs.channels):
-            o = tabs.offset(off, c)
-            base = c * tabs.width + o
-            m = int(tabs.rows[c, o])  # cells: a constant of the trace
-            j = dr.minimum(index(mu * m), m - 1)  # mu = 1: the last cell
-            h = base + 1 + 4 * j
-            anchor, inv_h, first, last = (dr.gather(tabs.float_type, tabs.data, h + i)
-                                          for i in range(4))
-            y = dr.maximum((mu - anchor) * inv_h, 0.0)  # >= 0 (float32 rounding of the anchor)
-            k = dr.minimum(index(y), index(last))  # the cell's last node
-            out.append(_cubic_drjit(dr, tabs, base + index(first) + 4 * k,
-                                    y - tabs.float_type(k)))
-        return tabs.combine(out)
-    return lookup_
-
-
-def _lookup_w_drjit(dr):
-    def lookup_w_(p, off, mu):
-        """:func:`_lookup_w` per channel with gathers."""
-        tabs = p.tables
-        index = dr.uint32_array_t(tabs.float_type)
-        w = dr.sqrt(_unit_drjit(dr, mu))
-        out = []
-        for c in range(tabs.channels):
-            o = tabs.offset(off, c)
-            w0, inv_h, n, w_min = (float(v) for v in tabs.rows[c, o:o + 4])
-            x = dr.maximum((dr.maximum(w, w_min) - w0) * inv_h, 0.0)  # held below w_min
-            j = dr.minimum(index(x), int(n) - 1)  # w = 1: the last interval
-            out.append(_cubic_drjit(dr, tabs, c * tabs.width + o + 4 + 4 * j,
-                                    x - tabs.float_type(j)))
-        return tabs.combine(out)
-    return lookup_w_
-
-
-primitive(lookup, _lookup_drjit)
-primitive(lookup_w, _lookup_w_drjit)
+primitive(lookup, lookup_drjit)
+primitive(lookup_w, lookup_w_drjit)
+primitive(row_from, row_from_drjit)

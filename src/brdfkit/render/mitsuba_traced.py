@@ -39,7 +39,7 @@ Tables and parameters
 ---------------------
 A model whose formulas read tables (``Formulas.tables = K``: a pumped model's albedo
 lookups) gets its first K columns as above and the rest as one Dr.Jit array, gathered
-from by :func:`brdfkit.tables.lookup` (:class:`~brdfkit.tables.TableRow`); a table per
+from by :func:`brdfkit.tables.lookup` (:class:`~brdfkit.traced_tables.TableRow`); a table per
 wavelength of a grid is not traced (:func:`wavefront_reason`). ``traverse`` lists the
 model's scalar and grey/RGB colour parameters by name, as Dr.Jit values in the row the
 eval formula reads (differentiable unless the model has tables, which are rebuilt in
@@ -58,7 +58,7 @@ import numpy as np
 
 from brdfkit._dual import drjit_version
 from brdfkit.models import BRDF
-from brdfkit.tables import TableRow, TracedTables
+from brdfkit.traced_tables import TableRow, TracedTables
 
 
 def traced_supported(model: BRDF, variant: str, grid: np.ndarray | None) -> bool:
