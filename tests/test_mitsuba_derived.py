@@ -313,3 +313,42 @@ def _render_plain(model, variant):
     del scene, bsdf
     gc.collect()
     return img
+
+
+@pytest.mark.parametrize("kw", [
+    {}, {"lobe": "phong"}, {"n": 0.0},
+    {"k_rho": [0.9, 0.6, 0.3], "k_sigma": [0.2, 0.5, 0.8], "n": 5.0, "lobe": "phong"},
+    {"k_sigma": 1.0, "n": 200.0}], ids=["blinn", "phong", "n0", "rgb-phong", "blinn-lobe-only"])
+def test_phong_energy_conserving_traced(kw):
+    """Lewis eq. (22) (H_s read in the trace) against model.eval, and its mixture sampler
+    formulas against model.sample/pdf (the NumPy Mixture of the cosine and the lobe): the
+    same directions and densities to float32 rounding; the formula's Numba compilation
+    against model.eval (float64)."""
+    variant = _variant("llvm_ad_rgb")
+    if not variant.startswith("llvm"):
+        pytest.skip("no LLVM")
+    model = brdfkit.model("phong-energy-conserving", **kw)
+    form = model.formulas()
+    ours = mitsuba_bsdf(model)
+    assert ours.traced
+    rng = np.random.default_rng(2)
+    n = 400
+    view, light = _hemisphere(rng, n), _hemisphere(rng, n)
+    light[: n // 2] = view[: n // 2] * np.array([-1.0, -1.0, 1.0])  # the lobe's peak
+    ctx = mi.BSDFContext()
+    si, wo = _interaction(view), mi.Vector3f(light.T.astype(np.float32))
+    want = np.asarray(model.eval(light, view)).reshape(n, -1)
+    got = np.array(ours.eval(ctx, si, wo)).T
+    np.testing.assert_allclose(got, np.broadcast_to(want * light[:, 2:3], got.shape),
+                               rtol=2e-4, atol=1e-6 * want.max())
+    np.testing.assert_allclose(np.array(ours.pdf(ctx, si, wo)), model.pdf(light, view),
+                               rtol=2e-4, atol=1e-6 * model.pdf(light, view).max())
+    u = rng.random((n, 2)).astype(np.float32)
+    bs, _ = ours.sample(ctx, si, 0.5, mi.Point2f(u.T))
+    want_wi, _ = model.sample(view, u.astype(float))
+    np.testing.assert_allclose(np.array(bs.wo).T, want_wi, atol=2e-5)
+    row = model.packed[0]
+    numba_f = [form.eval(*light[j], *view[j], row) for j in range(8)]
+    np.testing.assert_allclose(numba_f, want[:8, 0], rtol=1e-12)
+    del ours
+    gc.collect()
