@@ -22,6 +22,8 @@ LAYER = {
     "tables": 0, "_io": 0, "_dual": 0, "status": 0, "_cache": 0, "_threads": 0, "colour": 0,
     # glsl: the .brdf files' GLSL → formula source (issue 21; a translator, no models)
     "glsl": 0,
+    # traced_tables: the Dr.Jit side of tables' lookups (issue 23)
+    "traced_tables": 0,
     # the package root is the public facade (brdfkit.model resolves model names and
     # material specs; brdfkit.spec builds a ModelSpec, applying its operators): layer 2,
     # so the data layer and the operators (pumping) are beside it and cli/figures above

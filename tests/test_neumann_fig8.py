@@ -85,11 +85,14 @@ def test_metal_phong_closed_form_and_reciprocity():
     np.testing.assert_allclose(m.eval(a, b), m.eval(b, a), rtol=1e-12, atol=1e-300)
 
 
-def test_tiny_tank_render_is_finite_and_shares_paths_across_wavelengths():
+@pytest.mark.parametrize("base", ["modified-phong", "microfacet"])
+def test_tiny_tank_render_is_finite_and_shares_paths_across_wavelengths(base):
+    """Also with a base that gives formulas (microfacet): the traced route, no wavefront()."""
     pytest.importorskip("mitsuba")
     from brdfkit.render.tank import render_tank
 
-    phong = brdfkit.model("modified-phong", rho_d=0.0, rho_s=1.0, n=20.0)
+    phong = (brdfkit.model("modified-phong", rho_d=0.0, rho_s=1.0, n=20.0)
+             if base == "modified-phong" else brdfkit.model("microfacet", alpha=0.2))
     # 4 equal wavelengths: channel 3 comes from the second render (3 per render); with the
     # same seed and no Russian roulette both renders trace the same paths, so equal n, k
     # give equal channels exactly (what keeps colour noise out of the figure)
@@ -97,3 +100,35 @@ def test_tiny_tank_render_is_finite_and_shares_paths_across_wavelengths():
     assert img.shape == (12, 16, 4) and np.all(np.isfinite(img)) and np.all(img >= 0.0)
     assert img.max() > 0.0
     np.testing.assert_array_equal(img[..., 3], img[..., 0])
+
+
+@pytest.mark.parametrize("pumped", [False, True], ids=["plain", "pumped"])
+def test_fresnel_weighted_traced_equals_numpy(pumped):
+    """metal_phong over a base with formulas takes the traced route (the base's eval formula
+    times the Fresnel formula, a pumped base's tables read in the trace): its Mitsuba eval
+    against the NumPy eval (base.eval × fresnel_conductor at L·H), float32 rounding."""
+    mi = pytest.importorskip("mitsuba")
+    dr = pytest.importorskip("drjit")
+    from brdfkit.pumping import pump
+    from brdfkit.render.mitsuba_bridge import mitsuba_bsdf, use_variant
+
+    if not use_variant("llvm_ad_rgb").startswith("llvm"):
+        pytest.skip("no LLVM")
+    base = brdfkit.model("microfacet", alpha=0.3)
+    m = metal_phong(pump(base, "controlled") if pumped else base, [0.2, 0.9, 1.1],
+                    [3.9, 2.4, 2.2])
+    bsdf = mitsuba_bsdf(m)
+    assert bsdf.traced
+    rng = np.random.default_rng(4)
+    view, light = (rng.normal(size=(256, 3)) for _ in range(2))
+    for w in (view, light):
+        w[:, 2] = np.abs(w[:, 2]) + 0.05
+        w /= np.linalg.norm(w, axis=1, keepdims=True)
+    view, light = view.astype(np.float32).astype(float), light.astype(np.float32).astype(float)
+    si = dr.zeros(mi.SurfaceInteraction3f, 256)
+    si.wi = mi.Vector3f(view.T.astype(np.float32))
+    got = np.array(bsdf.eval(mi.BSDFContext(), si, mi.Vector3f(light.T.astype(np.float32)))).T
+    want = m.eval(light, view) * light[:, 2:3]
+    np.testing.assert_allclose(got, want, rtol=1e-4, atol=1e-6 * want.max())
+    grey = np.asarray(m.base.eval(light, view)).reshape(-1, 1) * light[:, 2:3]
+    assert np.abs(got - grey).max() > 0.05 * grey.max()  # power: the Fresnel factor is in it

@@ -414,6 +414,14 @@ def test_fallback_warning(monkeypatch):
     assert used == "scalar_spectral"
     msg = str(rec[0].message)
     assert "\n" not in msg and "libLLVM not found" in msg and "apt-get install libllvm19" in msg
+    # the route then falls back too, and says why in one line (issue 23)
+    from brdfkit.render.mitsuba_bridge import WavefrontRouteWarning
+
+    with pytest.warns(WavefrontRouteWarning) as rec:
+        bsdf = mitsuba_bsdf(brdfkit.model("microfacet", alpha=0.2))
+    msg = str(rec[0].message)
+    assert not bsdf.traced and "\n" not in msg and msg.endswith(bsdf.route_reason)
+    assert "microfacet: the scalar_spectral variant" in msg and "wavefront()" not in msg
 
 
 def test_spectral_metal_matches_roughconductor():

@@ -73,7 +73,8 @@ import numpy as np
 from brdfkit._cache import bounded_cache
 from brdfkit._kern import exp_nonpos
 
-__all__ = ["Formulas", "formula", "primitive", "drjit_version", "select", "sqrt", "exp", "log",
+__all__ = ["Formulas", "formula", "compose", "primitive", "drjit_version", "select", "sqrt",
+           "exp", "log",
            "log1p", "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "power", "floor",
            "minimum", "maximum", "absolute", "exp_nonpos", "numpy_version"]
 
@@ -105,6 +106,11 @@ class Formulas:
                   density (``model.pdf``)
     args          the sampler's parameters (Python floats, the same for every
                   channel)
+    tables        None, or the packed column from which on the row holds tables
+                  that *eval* reads with :func:`brdfkit.tables.lookup` (not
+                  parameters: the traced route holds those columns as one Dr.Jit
+                  array and gathers from it, ``docs/architecture.md``, "Tables
+                  in the trace")
     ============  ================================================================
     """
 
@@ -112,6 +118,7 @@ class Formulas:
     sample: Callable
     pdf: Callable
     args: tuple = ()
+    tables: int | None = None
 
 
 def formula(f=None, **options):
@@ -128,6 +135,32 @@ def formula(f=None, **options):
         return disp
 
     return deco if f is None else deco(f)
+
+
+#: memo: (template, bindings) → the composed formula (one per composition a derived model
+#: uses: a pumped or compensated model's structure; tens)
+_COMPOSED = bounded_cache("brdfkit._dual._COMPOSED", maxsize=256)
+
+
+def compose(template: Callable, **bindings) -> Callable:
+    """A formula from the plain function *template* with some of its global names bound.
+
+    The formula counterpart of :func:`brdfkit.models._drivers.composed`: *template* is
+    written over module globals (another formula, an int offset, a flag) that each
+    composition binds; the result is a formula (:func:`formula`, not cached on disk: its
+    globals are per composition) whose Dr.Jit version reads the bound values (a bound
+    formula is rebound recursively, a bound int or bool is a constant). Memoised per
+    (template, bindings).
+    """
+    key = (template, tuple(sorted(bindings.items())))
+    if key not in _COMPOSED:
+        ns = dict(template.__globals__)
+        ns.update(bindings)
+        fn = types.FunctionType(template.__code__, ns, template.__name__,
+                                template.__defaults__)
+        fn.__qualname__ = f"{template.__qualname__}[{', '.join(sorted(bindings))}]"
+        _COMPOSED[key] = formula(fn, cache=False)
+    return _COMPOSED[key]
 
 
 def primitive(obj, drjit: Callable):

@@ -20,8 +20,17 @@ model's divisor) needs, defined once:
    cubics on a two-level grid whose nodes include the function's kinks, with a
    verified margin so that it bounds the function from a chosen side.
 
-This is a low layer: it imports NumPy, Numba, :mod:`brdfkit.errors` and
-:mod:`brdfkit._kern` only
+3. **The lookups as formula primitives** (:func:`lookup`, :func:`lookup_w`,
+   registered with :func:`brdfkit._dual.primitive`): a formula (:mod:`brdfkit._dual`)
+   that reads a table packed into its row calls them; Numba inlines :func:`_lookup`
+   / :func:`_lookup_w`, Dr.Jit (the Mitsuba bridge's traced route) runs the same
+   cubic read with ``dr.gather`` from the table rows held once as a Dr.Jit array
+   (:class:`~brdfkit.traced_tables.TracedTables`, carried by the row a traced
+   formula receives, :class:`~brdfkit.traced_tables.TableRow`;
+   :mod:`brdfkit.traced_tables`).
+
+This is a low layer: it imports NumPy, Numba, :mod:`brdfkit.errors`,
+:mod:`brdfkit._kern`, :mod:`brdfkit._dual` and :mod:`brdfkit.traced_tables` only
 (models and engines import it, never the reverse).
 
 Public objects
@@ -32,6 +41,9 @@ Public objects
 - :class:`UniformLookup`, :func:`build_uniform_lookup`, :func:`_lookup_w` — a
   single-level table uniform in √μ (4 reads, one square root, for a function smooth
   in √μ: a compensation's E(μ)).
+- :func:`lookup`, :func:`lookup_w` — the two reads as formula primitives (the offset
+  may be a float read from the row); :func:`row_from` — a row's tail, for a formula that
+  wraps another's.
 - :data:`LUT_TOL`, :data:`LUT_CELLS` — the lookup's default tolerance and cells.
 """
 
@@ -44,8 +56,10 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from brdfkit._dual import primitive
 from brdfkit._kern import clamp_unit, load_input
 from brdfkit.errors import BrdfkitError, ParameterError
+from brdfkit.traced_tables import lookup_drjit, lookup_w_drjit, row_from_drjit
 
 __all__ = [
     "LUT_CELLS",
@@ -54,6 +68,9 @@ __all__ = [
     "UniformLookup",
     "build_lookup",
     "build_uniform_lookup",
+    "lookup",
+    "lookup_w",
+    "row_from",
     "mu_of_w",
     "theta_of_w",
     "w_of_mu",
@@ -453,3 +470,30 @@ def build_uniform_lookup(fn_w: Callable, *, w0: float, h: float, n: int, w_min: 
     data = np.ascontiguousarray(np.transpose(cub * (1.0 + sign * eps), (1, 0, 2)))
     return UniformLookup(w0=float(w0), h=float(h), n=int(n), w_min=float(w_min), data=data,
                          max_error=worst, epsilon=eps, bound=bound)
+
+
+# --------------------------------------------------------- the reads as formula primitives
+@numba.njit(cache=True, inline="always")
+def lookup(p, off, mu):  # pragma: no cover - compiled
+    """:func:`_lookup` for formulas (:mod:`brdfkit._dual`): *off* may be a float read from
+    the row (a stage's offset in a pumped model's trailer). Dr.Jit: :func:`_lookup_drjit`."""
+    return _lookup(p, numba.int64(off), mu)
+
+
+@numba.njit(cache=True, inline="always")
+def lookup_w(p, off, mu):  # pragma: no cover - compiled
+    """:func:`_lookup_w` for formulas, as :func:`lookup`. Dr.Jit: :func:`_lookup_w_drjit`."""
+    return _lookup_w(p, numba.int64(off), mu)
+
+
+@numba.njit(cache=True, inline="always")
+def row_from(p, n):  # pragma: no cover - compiled
+    """The row *p* from column *n* on (a view): a formula that passes a model's row on to
+    another model's formula after its own columns (:mod:`brdfkit.render.metals`'s Fresnel
+    weighting). Dr.Jit: the tuple's tail, a :class:`TableRow` keeping its tables."""
+    return p[n:]
+
+
+primitive(lookup, lookup_drjit)
+primitive(lookup_w, lookup_w_drjit)
+primitive(row_from, row_from_drjit)

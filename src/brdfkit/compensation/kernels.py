@@ -18,7 +18,10 @@ min(E, 1) within its margin; the kernels clamp what they read at 1 (:func:`_e`),
 (``docs/compensation.md``).
 
 - :func:`kulla_conty_kernel` — f_base + c (1 − Ẽ(μ_i))(1 − Ẽ(μ_o));
-- :func:`turquin_kernel` — f_base (1 + F₀ (1 − Ẽ(μ_i))/Ẽ(μ_i)).
+- :func:`turquin_kernel` — f_base (1 + F₀ (1 − Ẽ(μ_i))/Ẽ(μ_i));
+- :func:`turquin_formula` — the same as a formula (:mod:`brdfkit._dual`, the Mitsuba
+  bridge's traced route) over the base's eval formula, Ẽ read with
+  :func:`brdfkit.tables.lookup` / :func:`~brdfkit.tables.lookup_w`.
 
 A base whose eval is a formula is composed from the ``_vector`` templates, which LLVM
 vectorises with the table reads as gathers: every read a
@@ -30,11 +33,12 @@ from __future__ import annotations
 
 import numba
 
+from brdfkit._dual import compose, minimum
 from brdfkit._kern import load_input, load_inputs
 from brdfkit.models._drivers import VECTOR_OPTIONS, composed
-from brdfkit.tables import _lookup, _lookup_w
+from brdfkit.tables import _lookup, _lookup_w, lookup, lookup_w
 
-__all__ = ["kulla_conty_kernel", "turquin_kernel"]
+__all__ = ["kulla_conty_kernel", "turquin_formula", "turquin_kernel"]
 
 # The templates' globals, bound per composition (models/_drivers.composed): the base kernel,
 # the compile-time offset of the channel's constant, and the read of Ẽ (_e_two_level or
@@ -119,3 +123,21 @@ def turquin_kernel(base_kernel, k: int, *, vector: bool = False, uniform: bool =
     template = _turquin_vector if vector else _turquin
     return composed(template, loop=loop, options=options, base_kernel=base_kernel, k=int(k),
                     _e=_e_uniform if uniform else _e_two_level)
+
+
+# The formula template (brdfkit._dual.compose): base_eval an eval formula, read the
+# primitive lookup or lookup_w (as the table stores Ẽ), k the constant's column.
+base_eval = read = None
+
+
+def _turquin_f(ix, iy, iz, ox, oy, oz, p):
+    f = base_eval(ix, iy, iz, ox, oy, oz, p)  # 0 below the horizon
+    e_i = minimum(read(p, k + 1, iz), 1.0)  # clamp, as _e_two_level; >= E_FLOOR > 0
+    return f * (1.0 + p[k] * (1.0 - e_i) / e_i)
+
+
+def turquin_formula(base_eval, k: int, *, uniform: bool = False):
+    """:func:`turquin_kernel` as a formula over the base's eval formula (memoised); its
+    table starts at column k + 1 (``Formulas.tables``)."""
+    return compose(_turquin_f, base_eval=base_eval, k=int(k),
+                   read=lookup_w if uniform else lookup)

@@ -25,7 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from brdfkit._array import as_directions, as_uniform
-from brdfkit.compensation.kernels import kulla_conty_kernel, turquin_kernel
+from brdfkit._dual import Formulas
+from brdfkit.compensation.kernels import kulla_conty_kernel, turquin_formula, turquin_kernel
 from brdfkit.compensation.table import compensation_table
 from brdfkit.errors import ParameterError
 from brdfkit.models._base import BRDF, DerivedBRDF, Lobe
@@ -235,6 +236,19 @@ class CompensatedBRDF(DerivedBRDF):
         e = self._e(np.cos(th))
         factor = 1.0 + self.f0 * (1.0 - e) / e
         return s * (factor[..., 0] if np.ndim(s) == th.ndim else factor)
+
+    def formulas(self) -> Formulas | None:
+        """Turquin with a base that gives formulas: eval composed with Ẽ read in the trace
+        (:func:`~brdfkit.compensation.kernels.turquin_formula`), the base's sampler (as
+        :meth:`sample`). None for Kulla–Conty: its sampler's mixture weight reads Ẽ(ω_o),
+        which a sampler formula (float arguments, no row) cannot."""
+        base = self.base.formulas()
+        if self.method != "turquin" or self.kernel is None or base is None \
+                or base.tables is not None:
+            return None
+        k = self.base.packed.shape[1]
+        return Formulas(eval=turquin_formula(base.eval, k, uniform=self.table.uniform),
+                        sample=base.sample, pdf=base.pdf, args=base.args, tables=k + 1)
 
     # ---------------------------------------------------------------- sampling
     def _strategy(self, wo: np.ndarray) -> Strategy:

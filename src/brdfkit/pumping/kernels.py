@@ -15,16 +15,23 @@ Each is generated with its own compiled loop (:func:`brdfkit.models._drivers.com
 the base kernel inlined, the module cached on disk, so the next process loads it) and
 memoised per (kernel, structure). :data:`G_NUMPY` holds the built-in g in
 NumPy for models evaluated without a kernel.
+
+The same two as formulas (:mod:`brdfkit._dual`, for the Mitsuba bridge's traced
+route), composed from the root's or base's eval formula: :func:`chain_formula`,
+:func:`stage_formula`, :func:`pumped_formula`; the tables are read with
+:func:`brdfkit.tables.lookup`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from brdfkit._dual import compose, maximum, minimum, select
 from brdfkit.models._drivers import composed
-from brdfkit.tables import _lookup
+from brdfkit.tables import _lookup, lookup
 
-__all__ = ["G_NUMPY", "chain_kernel", "stage_kernel"]
+__all__ = ["G_NUMPY", "chain_formula", "chain_kernel", "pumped_formula", "stage_formula",
+           "stage_kernel"]
 
 # The kernels' templates (models/_drivers.composed): plain functions whose globals below
 # are bound per composition — the base kernel, the compile-time table offset and flags —
@@ -60,6 +67,54 @@ def _stage(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover - compiled
         if oz > g:
             g = oz
     return f / g
+
+
+# The formulas' templates (brdfkit._dual.compose): the same compositions over a root's or
+# base's eval *formula*, branch-free (selects), reading the tables with the primitive lookup.
+root_eval = base_eval = None  # an eval formula (ix, iy, iz, ox, oy, oz, p) -> f_r
+
+
+def _chain_f(ix, iy, iz, ox, oy, oz, p):
+    f = root_eval(ix, iy, iz, ox, oy, oz, p)  # 0 below the horizon
+    q = lookup(p, k, select(iz > oz, iz, oz))
+    if capped:
+        q = maximum(q, 1.0)  # eq. (17) g <= 1 for every stage (as _chain)
+    return select(f == 0.0, 0.0, f * q)
+
+
+def _stage_f(ix, iy, iz, ox, oy, oz, p):
+    f = base_eval(ix, iy, iz, ox, oy, oz, p)  # 0 below the horizon
+    off = p[-depth]  # the offsets trailer (as _stage's p[len(p) - depth])
+    a_i = lookup(p, off, iz)
+    a_o = lookup(p, off, oz)
+    g = select(a_i > a_o, a_i, a_o)
+    if capped:
+        g = minimum(g, 1.0)  # eq. (17) g <= 1
+    if controlled:
+        g = maximum(maximum(g, iz), oz)
+    return select(f == 0.0, 0.0, f / g)  # g >= G_FLOOR > 0 (the lookup's floor)
+
+
+def chain_formula(root_eval, k: int, capped: bool):
+    """:func:`chain_kernel` as a formula over the root's eval formula (memoised)."""
+    return compose(_chain_f, root_eval=root_eval, k=int(k), capped=bool(capped))
+
+
+def stage_formula(base_eval, controlled: bool, capped: bool, depth: int):
+    """:func:`stage_kernel` as a formula over the base's eval formula (memoised)."""
+    return compose(_stage_f, base_eval=base_eval, controlled=bool(controlled),
+                   capped=bool(capped), depth=int(depth))
+
+
+def pumped_formula(stage, root_eval):
+    """The eval formula of the pumped model *stage* (a :class:`~brdfkit.pumping.PumpedBRDF`
+    with a kernel) over its root's eval formula: the chain's, or its base's wrapped by this
+    stage's two lookups, as its kernel is composed."""
+    if stage.chained:
+        return chain_formula(root_eval, stage.root.packed.shape[1],
+                             all(s.capped for s in stage._chain))
+    base = root_eval if stage.base is stage.root else pumped_formula(stage.base, root_eval)
+    return stage_formula(base, stage.g == "controlled", stage.capped, stage.depth)
 
 
 def chain_kernel(root_kernel, k: int, capped: bool):

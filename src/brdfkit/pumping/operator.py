@@ -24,9 +24,10 @@ from collections.abc import Callable
 import numpy as np
 
 from brdfkit._array import as_directions
+from brdfkit._dual import Formulas
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models._base import BRDF, DerivedBRDF
-from brdfkit.pumping.kernels import G_NUMPY, chain_kernel, stage_kernel
+from brdfkit.pumping.kernels import G_NUMPY, chain_kernel, pumped_formula, stage_kernel
 from brdfkit.pumping.table import ENGINE_ERR, _crossings, _dips, build_albedo_table
 from brdfkit.tables import _as_2d, build_lookup, mu_of_w
 
@@ -374,6 +375,16 @@ class PumpedBRDF(DerivedBRDF):
         dup[:, 1:] = np.abs(np.diff(kv, axis=1)) < 1e-9
         kv = np.where(dup, np.nan, kv)
         return np.sort(kv, axis=1)  # NaNs last
+
+    def formulas(self) -> Formulas | None:
+        """The kernel as formulas when the root gives them (else None): eval composed from
+        the root's eval formula (:func:`~brdfkit.pumping.kernels.pumped_formula`), the
+        tables from the root's K columns on; the root's sampler and pdf (as :meth:`sample`)."""
+        root = self.root.formulas()
+        if root is None or self.kernel is None or root.tables is not None:
+            return None
+        return Formulas(eval=pumped_formula(self, root.eval), sample=root.sample,
+                        pdf=root.pdf, args=root.args, tables=self.root.packed.shape[1])
 
     def sample(self, wo, u):
         """The base model's sampler (the pdf is the base pdf)."""

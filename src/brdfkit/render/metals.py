@@ -77,9 +77,11 @@ import numpy as np
 from scipy.integrate import trapezoid
 
 from brdfkit._array import as_directions
+from brdfkit._dual import Formulas, compose, sqrt
 from brdfkit.errors import BrdfkitError, ParameterError
-from brdfkit.fresnel import fresnel_conductor
+from brdfkit.fresnel import _fresnel_conductor, fresnel_conductor
 from brdfkit.models import BRDF, DerivedBRDF, Param
+from brdfkit.tables import row_from
 
 __all__ = ["WAVELENGTHS", "METALS", "metal_nk", "band_edges", "cmf_weights",
            "xyz_to_linear_srgb", "spectral_to_linear_srgb", "FresnelWeightedBRDF",
@@ -214,6 +216,20 @@ ETA = Param("eta", 1.0, 0.0, 100.0, "", "real part of the index of refraction n"
 KAPPA = Param("k", 0.0, 0.0, 100.0, "", "extinction coefficient (conductors)", kind="colour")
 
 
+# The formula template of FresnelWeightedBRDF (brdfkit._dual.compose: base_eval bound to
+# the base's eval formula): the row is (η, κ, the base's row…).
+base_eval = None
+
+
+def _fresnel_weighted(ix, iy, iz, ox, oy, oz, p):
+    f = base_eval(ix, iy, iz, ox, oy, oz, row_from(p, 2))  # 0 below the horizon
+    sx = ix + ox
+    sy = iy + oy
+    sz = iz + oz
+    # L·H = |L + V|/2 for unit vectors (L = −V: 0, where f_base = 0)
+    return f * _fresnel_conductor(0.5 * sqrt(sx * sx + sy * sy + sz * sz), p[0], p[1])
+
+
 class FresnelWeightedBRDF(DerivedBRDF):
     """f(L, V) = F(L·H; η, κ) · f_base(L, V): a grey model times conductor Fresnel.
 
@@ -237,13 +253,18 @@ class FresnelWeightedBRDF(DerivedBRDF):
             raise ParameterError(f"base must be grey (one channel); {base.name} has "
                                  f"{base.n_channels} channels")
         self.base = base
+        # the formula's rows (formulas()): η, κ, then the base's row (eval is NumPy's)
+        n_c = max(np.size(eta), np.size(k))
+        packed = np.column_stack([np.broadcast_to(np.ravel(eta), (n_c,)),
+                                  np.broadcast_to(np.ravel(k), (n_c,)),
+                                  np.repeat(np.atleast_2d(base.packed)[:1], n_c, axis=0)])
         super().__init__(
             name=f"fresnel({base.name})", params=(ETA, KAPPA), values={"eta": eta, "k": k},
             citation=f"{base.citation}; times conductor Fresnel F(L.H; n, k)",
             summary=f"{base.name} times the conductor Fresnel reflectance at L.H",
             reciprocal=base.reciprocal, has_sampler=base.has_sampler,
             isotropic=base.isotropic, mirror_symmetric=base.mirror_symmetric, width_param=None,
-            kernel=None)
+            kernel=None, packed=packed)
         # F is smooth in the directions: f·F has the base's kinks, and so has its albedo
         self.albedo_kinks = base.albedo_kinks
         self.albedo_kink_mus = base.albedo_kink_mus
@@ -279,6 +300,16 @@ class FresnelWeightedBRDF(DerivedBRDF):
 
     def pdf(self, wi, wo):
         return self.base.pdf(wi, wo)
+
+    def formulas(self) -> Formulas | None:
+        """The base's eval formula times F(L·H; η, κ) over the row (η, κ, base row), the
+        base's sampler; None when the base gives no formulas."""
+        base = self.base.formulas()
+        if base is None:
+            return None
+        return Formulas(eval=compose(_fresnel_weighted, base_eval=base.eval),
+                        sample=base.sample, pdf=base.pdf, args=base.args,
+                        tables=None if base.tables is None else base.tables + 2)
 
     def with_params(self, **changes) -> BRDF:
         mine = {key: changes.pop(key) for key in ("eta", "k") if key in changes}

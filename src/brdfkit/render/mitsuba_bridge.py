@@ -4,21 +4,26 @@ Any brdfkit model as a Mitsuba 3 BSDF
 
 The formulas stay written once. Two routes, chosen per model (``route="auto"``):
 
-- **traced** (models whose :meth:`~brdfkit.models.BRDF.formulas` are given;
-  today ``microfacet``, GGX and Beckmann, with or without Fresnel): the
+- **traced** (models whose :meth:`~brdfkit.models.BRDF.formulas` are given:
+  ``microfacet``, user models, pumped models of those with their tables read
+  in the trace, :func:`brdfkit.tables.lookup`): the
   formula functions that Numba compiles for ``model.eval``/``sample``/``pdf``
   (:mod:`brdfkit._dual`) are rebound to Dr.Jit and called from a Python BSDF
   that Dr.Jit traces into Mitsuba's kernel, in its default symbolic mode
   (:mod:`brdfkit.render.mitsuba_traced`). As fast as Mitsuba's own BSDFs.
-- **wavefront** (every other model, the ``scalar_*`` variants, and RGB
-  channels in a spectral variant): Mitsuba calls a Python BSDF with whole
+- **wavefront** (the fallback: a model without formulas, the ``scalar_*``
+  variants, RGB channels in a spectral variant, tables per wavelength; the
+  BSDF's ``route_reason`` and a :class:`WavefrontRouteWarning` say which, in
+  one line): Mitsuba calls a Python BSDF with whole
   wavefronts (arrays of every path's directions) when Dr.Jit's symbolic loops,
   calls and conditionals are switched off (:func:`wavefront`), and the BSDF
   hands those arrays to ``model.eval``, ``model.sample`` and ``model.pdf`` as
   NumPy float64 arrays. Works for anything; 8-9× the time of Mitsuba's
   own BSDF at 256², 16 spp (see *Cost* below).
 
-A BSDF's ``traced`` attribute says which route it takes. The design record
+A BSDF's ``traced`` attribute says which route it takes. In ``*_ad_*`` variants a
+traced BSDF lists the model's parameters by name for ``mi.traverse``
+(:mod:`brdfkit.render.mitsuba_traced`). The design record
 (why, the formula contract) is in ``docs/architecture.md``.
 
 Conventions (where the two libraries meet)
@@ -103,15 +108,15 @@ from brdfkit.errors import ParameterError
 from brdfkit.models import BRDF
 from brdfkit.render.mitsuba_colour import ColourMap, check_wavelengths
 from brdfkit.render.mitsuba_plugin import register_plugin
-from brdfkit.render.mitsuba_traced import traced_class, traced_supported
+from brdfkit.render.mitsuba_traced import traced_class, wavefront_reason
 from brdfkit.render.mitsuba_variants import FALLBACK, VARIANTS, select_variant
 from brdfkit.render.mitsuba_variants import import_mitsuba as _mitsuba
 from brdfkit.render.mitsuba_wavefront import wavefront, wavefront_class
 from brdfkit.spec import model as build_model
 
-__all__ = ["FALLBACK", "ROUTES", "VARIANTS", "mitsuba_bsdf", "spectral_model", "use_variant",
-           "wavefront", "MAX_LANES", "MAX_SAMPLES", "MITSUBA_MAX_SIZE", "SEED_LIMIT",
-           "check_seed", "check_samples", "render_bounded"]
+__all__ = ["FALLBACK", "ROUTES", "VARIANTS", "WavefrontRouteWarning", "mitsuba_bsdf",
+           "spectral_model", "use_variant", "wavefront", "MAX_LANES", "MAX_SAMPLES",
+           "MITSUBA_MAX_SIZE", "SEED_LIMIT", "check_seed", "check_samples", "render_bounded"]
 
 #: Most paths (pixels x samples per pixel) of one ``mi.render`` call when the image has
 #: fewer pixels; a render with more is split into calls of fewer samples per pixel
@@ -211,16 +216,31 @@ def _make_bsdf(props, model: BRDF, wavelengths, variant: str, route: str):
     if model.has_delta:
         warnings.warn(f"brdfkit: {model.name}'s specular delta term is not rendered "
                       "by the Mitsuba bridge (only its kernel)", RuntimeWarning, stacklevel=3)
-    if route != "wavefront" and traced_supported(model, variant, grid):
+    reason = wavefront_reason(model, variant, grid)
+    if route != "wavefront" and reason is None:
         if variant not in _TRACED:
             _TRACED[variant] = traced_class(mi, dr, variant)
-        return _TRACED[variant](props, model, grid)
+        bsdf = _TRACED[variant](props, model, grid)
+        bsdf.route_reason = None
+        return bsdf
     if route == "traced":
         raise ParameterError(
-            f"route='traced' needs a model with formulas (model.formulas(); {model.name} has "
-            f"{'them' if model.formulas() is not None else 'none'}), an llvm_* variant "
-            f"(got {variant}) and grey, RGB or wavelength-grid channels; use route='auto'")
-    return wavefront_class(variant)(props, model=model, wavelengths=wavelengths)
+            f"route='traced' needs a model with formulas (model.formulas()), an llvm_* "
+            f"variant and grey, RGB or wavelength-grid channels: {reason}; use route='auto'")
+    bsdf = wavefront_class(variant)(props, model=model, wavelengths=wavelengths)
+    if route == "wavefront":
+        bsdf.route_reason = "route='wavefront' asked for"
+        return bsdf
+    bsdf.route_reason = f"{reason}: the wavefront route"
+    if variant.startswith("llvm"):
+        bsdf.route_reason += (", 3-9x slower than traced; render inside "
+                              "brdfkit.render.mitsuba_bridge.wavefront()")
+    warnings.warn(f"brdfkit: {bsdf.route_reason}", WavefrontRouteWarning, stacklevel=3)
+    return bsdf
+
+
+class WavefrontRouteWarning(UserWarning):
+    """A model takes the bridge's wavefront route (the one-line reason: ``route_reason``)."""
 
 
 def mitsuba_bsdf(model: BRDF, *, wavelengths=None, variant: str | None = None,
@@ -252,7 +272,9 @@ def mitsuba_bsdf(model: BRDF, *, wavelengths=None, variant: str | None = None,
         Usable as a value in a scene dict (``"bsdf": mitsuba_bsdf(model)``),
         in ``mi.chi2.BSDFAdapter``-style tests, or directly. Its attribute
         ``traced`` says which route it takes: False means render inside
-        :func:`wavefront` in ``llvm_*`` variants.
+        :func:`wavefront` in ``llvm_*`` variants; ``route_reason`` says why in
+        one line (None when traced), also given as a
+        :class:`WavefrontRouteWarning` when ``route="auto"`` falls back.
     """
     if not isinstance(model, BRDF):
         raise ParameterError(f"model must be a brdfkit model (BRDF); got {type(model)!r}")

@@ -35,6 +35,17 @@ form of :mod:`brdfkit.user`'s kernels) works unchanged: the index column is the
 channels); on a wavelength grid its index column would be interpolated, so give such
 a model RGB channels only.
 
+Tables and parameters
+---------------------
+A model whose formulas read tables (``Formulas.tables = K``: a pumped model's albedo
+lookups) gets its first K columns as above and the rest as one Dr.Jit array, gathered
+from by :func:`brdfkit.tables.lookup` (:class:`~brdfkit.traced_tables.TableRow`); a table per
+wavelength of a grid is not traced (:func:`wavefront_reason`). ``traverse`` lists the
+model's scalar and grey/RGB colour parameters by name, as Dr.Jit values in the row the
+eval formula reads (differentiable unless the model has tables, which are rebuilt in
+NumPy); ``parameters_changed`` rebuilds the model (``with_params``) and its sampler's
+arguments. Design record: ``docs/architecture.md``, "Tables in the trace".
+
 References
 ----------
 - W. Jakob et al., *Mitsuba 3 renderer*, 2022 (``BSDF`` interface, "Custom
@@ -47,20 +58,40 @@ import numpy as np
 
 from brdfkit._dual import drjit_version
 from brdfkit.models import BRDF
+from brdfkit.traced_tables import TableRow, TracedTables
 
 
 def traced_supported(model: BRDF, variant: str, grid: np.ndarray | None) -> bool:
     """Whether :func:`traced_class` can render *model* in *variant* (else the wavefront
-    route): the model gives formulas, the variant is an ``llvm_*`` one, and its channels
-    are grey, RGB in an RGB or mono variant, or a wavelength grid in a spectral one."""
-    if model.formulas() is None or not variant.startswith("llvm"):
-        return False
+    route): :func:`wavefront_reason` is None."""
+    return wavefront_reason(model, variant, grid) is None
+
+
+def wavefront_reason(model: BRDF, variant: str, grid: np.ndarray | None) -> str | None:
+    """Why *model* cannot take the traced route in *variant* (one line), or None when it
+    can: the model gives formulas, the variant is an ``llvm_*`` one, and its channels are
+    grey, RGB in an RGB or mono variant, or a wavelength grid in a spectral one (a model
+    with tables: grey in a spectral variant)."""
+    form = model.formulas()
+    if form is None:
+        return f"{model.name}: no formulas (eval/sample/pdf are NumPy/Numba only)"
+    if not variant.startswith("llvm"):
+        return f"{model.name}: the {variant} variant (the traced route needs an llvm_* one)"
     n_c = model.n_channels or 1
     if n_c == 1:
-        return True
+        return None
     if "spectral" in variant:
-        return grid is not None
-    return grid is None and n_c == 3
+        if grid is None:
+            return (f"{model.name}: RGB channels in a spectral variant (give its "
+                    "parameters on a wavelength grid: spectral_model)")
+        if form.tables is not None and not np.all(
+                model.packed[:, form.tables:] == model.packed[:1, form.tables:]):
+            return (f"{model.name}: per-wavelength tables (a table read per grid point and "
+                    "path is not traced)")
+        return None
+    if grid is None and n_c == 3:
+        return None
+    return f"{model.name}: {n_c} channels in {variant} (the traced route takes 1 or 3)"
 
 
 def _columns(packed: np.ndarray) -> list:
@@ -91,27 +122,42 @@ def traced_class(mi, dr, variant: str) -> type:
 
         def __init__(self, props, model: BRDF, grid: np.ndarray | None):
             mi.BSDF.__init__(self, props)
+            self.grid = grid
+            flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.DiffuseReflection
+            self.m_flags = flags
+            self.m_components = [flags]
+            self._bind(model)
+            # the exposed parameters (traverse): name → (column, Dr.Jit value)
+            self.exposed = {name: (col, _exposed_value(mi, self.columns[col]))
+                            for name, col in _parameter_columns(model, self.columns, kind)}
+
+        def _bind(self, model: BRDF):
+            """The model's formulas, sampler arguments, columns and tables."""
             form = model.formulas()
             self.model = model
             self.f_eval = drjit_version(form.eval)
             self.f_sample = drjit_version(form.sample)
             self.f_pdf = drjit_version(form.pdf)
             self.args = tuple(float(a) for a in form.args)
-            self.grid = grid
-            self.columns = _columns(model.packed)
-            if grid is None and kind != "spectral":
+            packed = np.atleast_2d(model.packed)
+            self.columns = _columns(packed[:, :form.tables])
+            self.tables = None if form.tables is None else TracedTables(
+                packed, form.tables, mi.Float, _combine)
+            self.differentiable = form.tables is None  # a table of the parameters: no gradient
+            if self.grid is None and kind != "spectral":
                 # fixed per-channel values: colours built once
                 self.fixed = tuple(c if isinstance(c, float) else mi.Color3f(*c.tolist())
                                    for c in self.columns)
-            flags = mi.BSDFFlags.GlossyReflection | mi.BSDFFlags.DiffuseReflection
-            self.m_flags = flags
-            self.m_components = [flags]
 
         def _params(self, si) -> tuple:
             if self.grid is None:
-                return self.fixed if kind != "spectral" else tuple(self.columns)
-            return tuple(c if isinstance(c, float) else interp(self.grid, c, si.wavelengths)
-                         for c in self.columns)
+                row = list(self.fixed if kind != "spectral" else self.columns)
+            else:
+                row = [c if isinstance(c, float) else interp(self.grid, c, si.wavelengths)
+                       for c in self.columns]
+            for col, value in self.exposed.values():
+                row[col] = value  # a Dr.Jit variable: traverse's, gradients flow from it
+            return tuple(row) if self.tables is None else TableRow(row, self.tables)
 
         def _spectrum(self, f):
             """f_r (Float, Color3f or Spectrum) as this variant's Spectrum."""
@@ -167,12 +213,60 @@ def traced_class(mi, dr, variant: str) -> type:
             return dr.zeros(mi.Spectrum)
 
         def traverse(self, callback):
-            pass
+            # the scalar (and grey or RGB colour) parameters eval reads, by the model's
+            # names; differentiable unless the model holds tables of them (rebuilt, no
+            # gradient through them: parameters_changed)
+            flag = (mi.ParamFlags.Differentiable if self.differentiable
+                    else mi.ParamFlags.NonDifferentiable)
+            for name, (_, value) in self.exposed.items():
+                callback.put(name, value, +flag)
 
         def parameters_changed(self, keys):
-            pass
+            changed = {k: v for k, v in self.exposed.items() if k in keys or not keys}
+            if not changed:
+                return
+            values = {k: _value_of(v) for k, (_, v) in changed.items()}
+            # the model with the new values: its tables, sampler arguments and other
+            # columns rebuilt (the exposed Dr.Jit values stay the ones eval reads)
+            self._bind(self.model.with_params(**values))
 
         def to_string(self):
             return f"BrdfkitBSDF[traced, {self.model!r}]"
 
+    def _combine(values: list):
+        """Per-channel lookups as the row's colour (one: as it is)."""
+        return values[0] if len(values) == 1 else mi.Color3f(*values)
+
     return TracedBSDF
+
+
+def _parameter_columns(model: BRDF, columns: list, kind: str) -> list:
+    """(name, column) of the model's scalar and colour parameters in their default packed
+    slots (:func:`brdfkit.models._params.packed_indices`) whose column holds exactly the
+    parameter's value in every channel (a model packing otherwise exposes fewer), and is a
+    float or, outside spectral variants, three channels."""
+    out = []
+    for col, p in enumerate(model.params):
+        if p.kind == "lobes" or col >= len(columns):
+            break
+        if p.kind not in ("scalar", "colour") or model.values.get(p.name) is None:
+            continue
+        value = np.broadcast_to(np.asarray(model.values[p.name], dtype=np.float64),
+                                (np.atleast_2d(model.packed).shape[0],))
+        c = columns[col]
+        if isinstance(c, float) and np.all(value == c) or (
+                kind != "spectral" and not isinstance(c, float) and c.size == 3
+                and np.array_equal(c, value)):
+            out.append((p.name, col))
+    return out
+
+
+def _exposed_value(mi, column):
+    """A column as the Dr.Jit value traverse exposes: a Float, or a Color3f."""
+    return mi.Float(column) if isinstance(column, float) else mi.Color3f(*column.tolist())
+
+
+def _value_of(value):
+    """An exposed Dr.Jit value as the model's parameter value (a float or 3 floats)."""
+    a = np.array(value, dtype=np.float64).reshape(-1)
+    return float(a[0]) if a.size == 1 else a.tolist()

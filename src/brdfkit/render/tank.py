@@ -50,6 +50,7 @@ Public objects
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Callable
 
 import numpy as np
@@ -242,7 +243,9 @@ def render_tank(phong: BRDF, *, size: int = 320, spp: int = 16, seed: int = 0,
         bsdfs = {m: mitsuba_bsdf(metal_phong(phong, n[idx], k[idx])) for m, (n, k) in nk.items()}
         scene = mi.load_dict(tank_scene(bsdfs, width=width, height=height,
                                         max_depth=max_depth))
-        with wavefront():
+        # traced BSDFs render in Dr.Jit's default symbolic mode; wavefront ones need it off
+        traced = all(b.traced for b in bsdfs.values())
+        with contextlib.nullcontext() if traced else wavefront():
             image = render_bounded(scene, spp=spp, seed=seed, pixels=width * height)
         keep = idx[: min(PACK, lam.size - start)]
         out[:, :, keep] = image[:, :, : keep.size]
