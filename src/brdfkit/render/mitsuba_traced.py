@@ -47,15 +47,19 @@ import numpy as np
 
 from brdfkit._dual import drjit_version
 from brdfkit.models import BRDF
+from brdfkit.render.mitsuba_rows import traced_row
 
 
 def traced_supported(model: BRDF, variant: str, grid: np.ndarray | None) -> bool:
     """Whether :func:`traced_class` can render *model* in *variant* (else the wavefront
     route): the model gives formulas, the variant is an ``llvm_*`` one, and its channels
     are grey, RGB in an RGB or mono variant, or a wavelength grid in a spectral one."""
-    if model.formulas() is None or not variant.startswith("llvm"):
+    form = model.formulas()
+    if form is None or not variant.startswith("llvm"):
         return False
     n_c = model.n_channels or 1
+    if getattr(form, "table", None):  # a gathered table: RGB or grey channels, no grid
+        return grid is None and "spectral" not in variant and n_c in (1, 3)
     if n_c == 1:
         return True
     if "spectral" in variant:
@@ -98,8 +102,12 @@ def traced_class(mi, dr, variant: str) -> type:
             self.f_pdf = drjit_version(form.pdf)
             self.args = tuple(float(a) for a in form.args)
             self.grid = grid
-            self.columns = _columns(model.packed)
-            if grid is None and kind != "spectral":
+            table = getattr(form, "table", None)  # TableFormulas: columns read by row_at
+            self.columns = None if table else _columns(model.packed)
+            if table and grid is None and kind != "spectral":
+                # the table's columns one Dr.Jit array, read by dr.gather (mitsuba_rows)
+                self.fixed = traced_row(mi, dr, model.packed, table)
+            elif grid is None and kind != "spectral":
                 # fixed per-channel values: colours built once
                 self.fixed = tuple(c if isinstance(c, float) else mi.Color3f(*c.tolist())
                                    for c in self.columns)
