@@ -64,9 +64,8 @@ class TracedRow:
         idx = mi.UInt32(dr.select(ok, j, 0.0))
         if self._n == 1:
             return dr.gather(mi.Float, self._table, idx, ok)
-        base = idx * self._n
-        return mi.Color3f(*(dr.gather(mi.Float, self._table, base + c, ok)
-                            for c in range(self._n)))
+        # one gather of the three consecutive channels of column j (a packet read)
+        return dr.gather(mi.Color3f, self._table, idx, ok)
 
 
 def traced_row(mi, dr, packed: np.ndarray, table: tuple) -> TracedRow:
