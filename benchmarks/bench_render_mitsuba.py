@@ -201,13 +201,15 @@ def measured_rows(mi, args) -> None:
          False),
         ("merl:nickel@sgd (traced)", lambda: mitsuba_bsdf(brdfkit.model("merl:nickel@sgd")),
          False),
+        ("MERL table, nearest (traced)",
+         lambda: mitsuba_bsdf(table.with_params(lookup="nearest")), False),
         ("MERL table, linear (traced)", lambda: mitsuba_bsdf(table), False),
         ("MERL table, linear (wavefront route)",
          lambda: mitsuba_bsdf(table, route="wavefront"), True),
     ]
     results = time_rows(mi, rows, variant, args)
     report(results, rows, variant, args,
-           pairs=[(rows[1][0], rows[2][0]), (rows[6][0], rows[7][0])], same=[])
+           pairs=[(rows[1][0], rows[2][0]), (rows[7][0], rows[8][0])], same=[])
 
 
 def spectral_rows(mi, args) -> None:

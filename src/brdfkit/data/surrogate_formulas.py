@@ -212,7 +212,7 @@ from brdfkit.data.surrogate_formulas import nbrdf_features
 from brdfkit.data.table_formulas import expm1
 
 
-@formula(cache={cache})
+@formula(cache={cache}, inline="never")
 def nbrdf_eval(ix, iy, iz, ox, oy, oz, p):
     live = (iz > 0.0) & (oz > 0.0)
     x0, x2, x3, x4, x5 = nbrdf_features(ix, iy, iz, ox, oy, oz)
