@@ -19,6 +19,15 @@ constant environment L_a = 0.2, ``path`` integrator with max_depth 2, S×S pixel
 - ``bridge lambert`` (traced: its formulas, as microfacet's; and with
   ``route="wavefront"``) and Mitsuba's ``diffuse`` (ρ = 0.5): the cheapest pair;
 
+in ``llvm_ad_rgb`` again, measured materials (issue 23): ``merl:nickel`` (the NBRDF net),
+``@npf``, ``@abc``, ``@sgd`` and a MERL table (``@abc`` tabulated on the MERL grid, linear
+lookup, one Dr.Jit array gathered in the kernel) on the traced route (their formulas,
+the proxy sampler), ``merl:nickel`` and the table on the wavefront route too, against
+Mitsuba's ``roughconductor`` of nickel's proxy α (the GGX α fitted to the material's
+lobe, :func:`brdfkit.user.proxy_sampler.proxy_args`) — the closest native BSDF; the
+images of a material are compared between its two routes (different samplers of one
+f_r: within Monte-Carlo noise);
+
 and in ``llvm_ad_spectral`` a gold-like metal with n(λ), k(λ) on a 16-point grid over
 360-830 nm: Mitsuba's ``roughconductor`` with the grid as ``irregular`` spectra against
 the bridge's traced ``spectral_model("microfacet", …)`` (parameters interpolated at each
@@ -129,11 +138,24 @@ def main() -> None:
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--spp", type=int, default=16)
     ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--sections", default="rgb,measured,spectral",
+                    help="comma-separated subset of rgb, measured, spectral")
     args = ap.parse_args()
+    sections = set(args.sections.split(","))
 
     import mitsuba as mi
 
     print(f"load average before: {os.getloadavg()[0]:.2f}")
+    if "rgb" in sections:
+        rgb_rows(mi, args)
+    if "measured" in sections:
+        measured_rows(mi, args)
+    if "spectral" in sections:
+        spectral_rows(mi, args)
+    print(f"\nload average after: {os.getloadavg()[0]:.2f}")
+
+
+def rgb_rows(mi, args) -> None:
     variant = use_variant("llvm_ad_rgb")
     model = brdfkit.model("microfacet", distribution="ggx", alpha=ALPHA, eta=ETA, k=K)
     native = {"type": "roughconductor", "distribution": "ggx", "alpha": ALPHA,
@@ -156,6 +178,44 @@ def main() -> None:
                   (rows[4][0], rows[6][0])],
            same=[(rows[2][0], rows[3][0]), (rows[5][0], rows[6][0])])
 
+
+def measured_rows(mi, args) -> None:
+    from brdfkit.data.measured import MeasuredBRDF
+    from brdfkit.data.merl import table_from_function
+    from brdfkit.user.proxy_sampler import proxy_args
+
+    variant = use_variant("llvm_ad_rgb")
+    nickel = brdfkit.model("merl:nickel")
+    table = MeasuredBRDF(table_from_function(brdfkit.model("merl:nickel@abc").eval,
+                                             source="nickel@abc"), lookup="linear")
+    alpha = proxy_args(nickel)[0]
+    # nickel's n, k at ~650, 550, 450 nm (Johnson & Christy 1974 / refractiveindex.info)
+    native = {"type": "roughconductor", "distribution": "ggx", "alpha": alpha,
+              "eta": {"type": "rgb", "value": [2.0, 1.8, 1.6]},
+              "k": {"type": "rgb", "value": [3.9, 3.4, 2.8]}}
+    rows = [
+        (f"roughconductor α={alpha:.3f} (Mitsuba, symbolic)", lambda: native, False),
+        ("merl:nickel NBRDF (traced)", lambda: mitsuba_bsdf(nickel), False),
+        ("merl:nickel NBRDF (wavefront route)",
+         lambda: mitsuba_bsdf(nickel, route="wavefront"), True),
+        ("merl:nickel@npf (traced)", lambda: mitsuba_bsdf(brdfkit.model("merl:nickel@npf")),
+         False),
+        ("merl:nickel@abc (traced)", lambda: mitsuba_bsdf(brdfkit.model("merl:nickel@abc")),
+         False),
+        ("merl:nickel@sgd (traced)", lambda: mitsuba_bsdf(brdfkit.model("merl:nickel@sgd")),
+         False),
+        ("MERL table, nearest (traced)",
+         lambda: mitsuba_bsdf(table.with_params(lookup="nearest")), False),
+        ("MERL table, linear (traced)", lambda: mitsuba_bsdf(table), False),
+        ("MERL table, linear (wavefront route)",
+         lambda: mitsuba_bsdf(table, route="wavefront"), True),
+    ]
+    results = time_rows(mi, rows, variant, args)
+    report(results, rows, variant, args,
+           pairs=[(rows[1][0], rows[2][0]), (rows[7][0], rows[8][0])], same=[])
+
+
+def spectral_rows(mi, args) -> None:
     variant = use_variant("llvm_ad_spectral")
     metal, grid = spectral_model("microfacet", GRID, distribution="ggx", alpha=ALPHA,
                                  eta=n_gold_like, k=k_gold_like)
@@ -171,7 +231,6 @@ def main() -> None:
     results = time_rows(mi, rows, variant, args)
     report(results, rows, variant, args,
            pairs=[(rows[0][0], rows[1][0]), (rows[0][0], rows[2][0])], same=[])
-    print(f"\nload average after: {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":

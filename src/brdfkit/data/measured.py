@@ -33,6 +33,7 @@ from brdfkit.data._merl_index import (
     _table_driver,
 )
 from brdfkit.data.merl import N_BINS, SHAPE, MerlTable, bin_centres
+from brdfkit.data.merl_formulas import measured_formulas
 from brdfkit.data.sampler import TabulatedSampler
 from brdfkit.errors import ParameterError
 from brdfkit.models._base import DerivedBRDF, Lobe, Param
@@ -203,6 +204,12 @@ class MeasuredBRDF(TabulatedSampler, DerivedBRDF):
 
     def lobes(self):
         return [Lobe("diffuse", 0.5 * math.pi), Lobe("half", self._width)]
+
+    def formulas(self):
+        """The lookup as a formula over the packed row, the cosine + GGX proxy of the
+        table's lobe as sampler (:func:`brdfkit.data.merl_formulas.measured_formulas`): the
+        Mitsuba bridge's traced route, the table one Dr.Jit array."""
+        return measured_formulas(self)
 
     def provenance(self) -> str:
         """Verdicts on this model are verdicts on the table and its lookup (docstring)."""

@@ -24,6 +24,7 @@ import math
 import numpy as np
 
 from brdfkit.data.sampler import TabulatedSampler
+from brdfkit.data.surrogate_formulas import surrogate_formulas
 from brdfkit.errors import ParameterError
 from brdfkit.models._base import DerivedBRDF, Lobe
 
@@ -186,6 +187,12 @@ class SurrogateBRDF(TabulatedSampler, DerivedBRDF):
         if self._width >= HALF_PI:
             return [Lobe("diffuse", HALF_PI)]
         return [Lobe("diffuse", HALF_PI), Lobe("half", self._width)]
+
+    def formulas(self):
+        """f_r as a formula of its representation, the cosine + GGX proxy of its lobe as
+        sampler (:func:`brdfkit.data.surrogate_formulas.surrogate_formulas`): the Mitsuba
+        bridge's traced route."""
+        return surrogate_formulas(self)
 
     def provenance(self) -> str:
         """Verdicts on this model are verdicts on the surrogate (class docstring)."""
