@@ -41,18 +41,18 @@ def _commands(out_png: str) -> dict[str, list[str]]:
                                      "--ambient", "0.5", "--size", "64", "--out", out_png]}
 
 
-def _run(src: str, args: list[str], cache: str) -> float:
+def _run(src: str, args: list[str], cache: str) -> tuple[float, str]:
+    """(wall seconds, "" or the last line of stderr when the command failed)."""
     env = {**os.environ, "PYTHONPATH": src, "BRDFKIT_CACHE_DIR": cache}
     t0 = time.perf_counter()
     p = subprocess.run([sys.executable, "-m", "brdfkit", *args], env=env,
                        capture_output=True, text=True)
     seconds = time.perf_counter() - t0
-    if p.returncode != 0:
-        raise SystemExit(f"brdfkit {' '.join(args)} failed: {p.stderr.strip()}")
-    return seconds
+    failed = "" if p.returncode == 0 else (p.stderr.strip().splitlines() or ["?"])[-1]
+    return seconds, failed
 
 
-def _trees(src: str, label: str, user_cache: Path) -> list[tuple[str, str, str, float]]:
+def _trees(src: str, label: str, user_cache: Path, states=("cold", "warm")) -> list[tuple]:
     rows = []
     with tempfile.TemporaryDirectory(prefix="bench-material-") as tmp:
         cache = Path(tmp) / "cache"
@@ -61,10 +61,11 @@ def _trees(src: str, label: str, user_cache: Path) -> list[tuple[str, str, str, 
         if drivers.is_dir():
             (cache / "drivers").symlink_to(drivers)
         _run(src, ["eval", MATERIAL, "--wi", "30,0", "--wo", "30,180"], str(cache))  # warm-up
-        for state in ("cold", "warm"):
+        for state in states:
             for name, args in _commands(str(Path(tmp) / "s.png")).items():
-                rows.append((label, name, state, _run(src, args, str(cache))))
-                print(f"  {label} {name} {state}: {rows[-1][3]:.1f} s", file=sys.stderr)
+                rows.append((label, name, state, *_run(src, args, str(cache))))
+                print(f"  {label} {name} {state}: {rows[-1][3]:.1f} s {rows[-1][4]}",
+                      file=sys.stderr)
     return rows
 
 
@@ -77,13 +78,15 @@ def main(argv=None) -> int:
     print("load average (1, 5, 15 min): {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     rows = []
     if args.before:
-        rows += _trees(args.before, "before", Path(root))
+        # a tree before the store has no warm state: its second run costs the same
+        rows += _trees(args.before, "before", Path(root), states=("cold",))
     rows += _trees(SRC, "this tree", Path(root))
     print()
-    print(f"| {'tree':<10} | {'command':<22} | {'results':<7} | {'wall (s)':>8} |")
-    print(f"|{'-' * 12}|{'-' * 24}|{'-' * 9}|{'-' * 10}|")
-    for label, name, state, seconds in rows:
-        print(f"| {label:<10} | {name:<22} | {state:<7} | {seconds:8.1f} |")
+    print(f"| {'tree':<10} | {'command':<22} | {'results':<7} | {'wall (s)':>8} | outcome |")
+    print(f"|{'-' * 12}|{'-' * 24}|{'-' * 9}|{'-' * 10}|---------|")
+    for label, name, state, seconds, failed in rows:
+        print(f"| {label:<10} | {name:<22} | {state:<7} | {seconds:8.1f} | "
+              f"{('failed: ' + failed) if failed else 'ok'} |")
     print()
     print("load average (1, 5, 15 min): {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     return 0

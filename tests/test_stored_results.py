@@ -130,3 +130,17 @@ def test_ambient_table_of_a_coloured_non_reciprocal_material_has_every_channel(n
     slow._driver = None
     ref = albedo_engine.albedo(slow, t.theta[:3], tol=1e-4).albedo
     np.testing.assert_allclose(t.rho[:3], ref, atol=2e-3)
+
+
+def test_render_of_nbrdf_material_with_ambient_light(nickel):
+    # the command of issue 23 failed with "cannot reshape array ... into shape (3)" at the
+    # rim (a one-channel ambient table of a three-channel material); reference: each
+    # pixel of a sphere lit by ambient light only is L_a·ρ(θ_V) of the table (Lewis eq. 7)
+    from brdfkit.render import render_sphere
+
+    r = render_sphere(nickel, phi_l=0.0, ambient=0.5, irradiance=0.0, size=8, rho_tol=1e-3)
+    assert r.radiance.shape == (8, 8, 3) and np.all(np.isfinite(r.radiance))
+    t = ambient.ambient_table(nickel, theta_max=1.5, tol=1e-3)
+    c = (np.arange(8) + 0.5) / 8 * 2 - 1  # pixel centres; (3, 3) is inside, not on the rim
+    theta_v = np.arccos(np.sqrt(1 - c[3] ** 2 - c[3] ** 2))
+    np.testing.assert_allclose(r.radiance[3, 3], 0.5 * t(theta_v), atol=2e-3)
