@@ -14,12 +14,14 @@ Rows
   ``SurfaceInteraction3f``/``BSDFContext`` → ``BSDF.eval`` → ``Color3f`` →
   NumPy, all inside the timed region. Mitsuba's ``eval`` returns f_r·cos θ
   (its convention); the cosine costs one multiply and is not removed.
-- Mitsuba 3 with a Python-registered modified Phong BSDF (``mi.register_bsdf``),
-  evaluated the same way (Dr.Jit traces the Python ``eval`` into one LLVM kernel).
+- Mitsuba 3 with Python-registered twins (``mi.register_bsdf``) of ``modified-phong``,
+  ``nielsen`` and ``cook-torrance`` (the same formulas written in Dr.Jit:
+  :func:`twin_formulas`), evaluated the same way (Dr.Jit traces the Python ``eval`` into
+  one LLVM kernel).
 - Plain NumPy modified Phong (vectorised array expressions, float64).
 
 The ratio column is brdfkit / Mitsuba for the comparable pairs: ``microfacet``
-vs ``roughconductor`` and ``modified-phong`` vs the Python-registered Phong.
+vs ``roughconductor`` and each twinned model vs its Python-registered twin.
 Before timing, the script checks that the compared implementations agree
 (relative difference of f_r·cos θ on 10⁵ pairs; Mitsuba is single precision
 and uses the rational fit of the Beckmann G₁, brdfkit the exact erf form,
@@ -136,6 +138,48 @@ def probe_mitsuba_llvm() -> str:
     return ""
 
 
+#: The brdfkit models with a Dr.Jit twin (name → Mitsuba row), at these parameters.
+NIELSEN = {"rho_d": 0.2, "k_s": 2.0, "s": 20.0, "alpha": 0.5}  # brdfkit's defaults, F = 1
+COOK = {"m": 0.1, "rho_s": 1.0}  # brdfkit's defaults, F = 1
+#: Floor of (N·L)(N·V) in Cook-Torrance's denominator (brdfkit.models.vgroove.DENOM_FLOOR).
+DENOM_FLOOR = 1e-280
+TWINS = {"modified-phong": "python-phong", "nielsen": "python-nielsen",
+         "cook-torrance": "python-cook-torrance"}
+
+
+def twin_formulas(dr, mi):
+    """name → f(v, light, cos_v, cos_l) -> f_r: the brdfkit formulas in Dr.Jit (float32).
+
+    Same expressions as the brdfkit kernels (models/phong.py, grazing.py ``_nielsen``,
+    vgroove.py ``_cook_torrance``), without the far-grazing underflow branches (both
+    directions within 1e-140 of the horizon: no random pair gets there).
+    """
+    def phong(v, light, cos_v, cos_l):
+        r_dot_v = dr.maximum(dr.dot(mi.reflect(v), light), 0.0)
+        return (PHONG["rho_d"] / math.pi + PHONG["rho_s"] * (PHONG["n"] + 2.0)
+                / (2.0 * math.pi) * dr.power(r_dot_v, PHONG["n"]))
+
+    def nielsen(v, light, cos_v, cos_l):
+        a = NIELSEN["alpha"]
+        h = v + light
+        hz = h.z * dr.rsqrt(dr.squared_norm(h))  # N·H
+        hz2 = hz * hz
+        base = (1.0 - a) * (2.0 * cos_v * cos_l - dr.dot(v, light)) + a * hz2 * hz2
+        return (NIELSEN["rho_d"] / math.pi
+                + NIELSEN["k_s"] * dr.power(dr.maximum(base, 0.0), NIELSEN["s"]))
+
+    def cook(v, light, cos_v, cos_l):
+        m = COOK["m"]
+        h = v + light
+        l2 = dr.squared_norm(h)
+        c2 = h.z * h.z / l2  # cos²δ
+        d = dr.exp(-(1.0 - c2) / (c2 * m * m)) / (4.0 * math.pi * m * m * c2 * c2)
+        g = dr.minimum(1.0, 4.0 * h.z * dr.minimum(cos_v, cos_l) / l2)  # V-groove G
+        return COOK["rho_s"] * d * g / dr.maximum(cos_v * cos_l, DENOM_FLOOR)
+
+    return {"python-phong": phong, "python-nielsen": nielsen, "python-cook-torrance": cook}
+
+
 def make_mitsuba(pairs_wi: np.ndarray, pairs_wo: np.ndarray):
     """Return {name: callable() -> NumPy result} for the Mitsuba rows (variant llvm_ad_rgb)."""
     import drjit as dr
@@ -143,48 +187,51 @@ def make_mitsuba(pairs_wi: np.ndarray, pairs_wo: np.ndarray):
 
     mi.set_variant("llvm_ad_rgb")
 
-    class ModifiedPhongBSDF(mi.BSDF):
-        """Nielsen eq. (1) as a Mitsuba BSDF; eval returns f_r cos θ_o (Mitsuba's convention)."""
+    def python_bsdf(formula):
+        class TwinBSDF(mi.BSDF):
+            """A brdfkit formula as a Mitsuba BSDF; eval returns f_r cos θ_o (Mitsuba's
+            convention)."""
 
-        def __init__(self, props):
-            mi.BSDF.__init__(self, props)
-            self.rho_d = float(props.get("rho_d", PHONG["rho_d"]))
-            self.rho_s = float(props.get("rho_s", PHONG["rho_s"]))
-            self.n = float(props.get("n", PHONG["n"]))
-            self.m_flags = mi.BSDFFlags.DiffuseReflection | mi.BSDFFlags.GlossyReflection
-            self.m_components = [self.m_flags]
+            def __init__(self, props):
+                mi.BSDF.__init__(self, props)
+                self.m_flags = mi.BSDFFlags.DiffuseReflection | mi.BSDFFlags.GlossyReflection
+                self.m_components = [self.m_flags]
 
-        def eval(self, ctx, si, wo, active=True):
-            cos_i = mi.Frame3f.cos_theta(si.wi)
-            cos_o = mi.Frame3f.cos_theta(wo)
-            r_dot_v = dr.maximum(dr.dot(mi.reflect(si.wi), wo), 0.0)
-            f = (self.rho_d / math.pi
-                 + self.rho_s * (self.n + 2.0) / (2.0 * math.pi) * dr.power(r_dot_v, self.n))
-            return mi.Color3f(dr.select((cos_i > 0) & (cos_o > 0), f * cos_o, 0.0))
+            def eval(self, ctx, si, wo, active=True):
+                cos_i = mi.Frame3f.cos_theta(si.wi)
+                cos_o = mi.Frame3f.cos_theta(wo)
+                f = formula(si.wi, wo, cos_i, cos_o)
+                return mi.Color3f(dr.select((cos_i > 0) & (cos_o > 0), f * cos_o, 0.0))
 
-        def pdf(self, ctx, si, wo, active=True):
-            return mi.warp.square_to_cosine_hemisphere_pdf(wo)
+            def pdf(self, ctx, si, wo, active=True):
+                return mi.warp.square_to_cosine_hemisphere_pdf(wo)
 
-        def eval_pdf(self, ctx, si, wo, active=True):
-            return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
+            def eval_pdf(self, ctx, si, wo, active=True):
+                return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
 
-        def sample(self, ctx, si, sample1, sample2, active=True):
-            bs = mi.BSDFSample3f()
-            bs.wo = mi.warp.square_to_cosine_hemisphere(sample2)
-            bs.pdf = mi.warp.square_to_cosine_hemisphere_pdf(bs.wo)
-            bs.eta = 1.0
-            bs.sampled_type = mi.UInt32(+mi.BSDFFlags.DiffuseReflection)
-            bs.sampled_component = 0
-            value = self.eval(ctx, si, bs.wo, active) / dr.maximum(bs.pdf, 1e-12)
-            return bs, value
+            def sample(self, ctx, si, sample1, sample2, active=True):
+                bs = mi.BSDFSample3f()
+                bs.wo = mi.warp.square_to_cosine_hemisphere(sample2)
+                bs.pdf = mi.warp.square_to_cosine_hemisphere_pdf(bs.wo)
+                bs.eta = 1.0
+                bs.sampled_type = mi.UInt32(+mi.BSDFFlags.DiffuseReflection)
+                bs.sampled_component = 0
+                value = self.eval(ctx, si, bs.wo, active) / dr.maximum(bs.pdf, 1e-12)
+                return bs, value
 
-        def to_string(self):
-            return "ModifiedPhongBSDF[]"
+            def to_string(self):
+                return "TwinBSDF[]"
 
-    mi.register_bsdf("bench_modified_phong", lambda props: ModifiedPhongBSDF(props))
-    rough = mi.load_dict({"type": "roughconductor", "distribution": "beckmann", "alpha": ALPHA,
-                          "material": "none"})
-    phong = mi.load_dict({"type": "bench_modified_phong", **PHONG})
+        return TwinBSDF
+
+    bsdfs = {"roughconductor": mi.load_dict({"type": "roughconductor",
+                                             "distribution": "beckmann", "alpha": ALPHA,
+                                             "material": "none"})}
+    for name, formula in twin_formulas(dr, mi).items():
+        plugin = "bench_" + name.replace("-", "_")
+        twin = python_bsdf(formula)
+        mi.register_bsdf(plugin, lambda props, cls=twin: cls(props))
+        bsdfs[name] = mi.load_dict({"type": plugin})
     ctx = mi.BSDFContext()
 
     def run(bsdf, wi, wo):
@@ -195,11 +242,9 @@ def make_mitsuba(pairs_wi: np.ndarray, pairs_wo: np.ndarray):
         value = bsdf.eval(ctx, si, light)
         return np.asarray(value.numpy(), dtype=np.float64)  # (3, N), f_r cos θ_light
 
-    return {
-        "roughconductor": lambda wi=pairs_wi, wo=pairs_wo: run(rough, wi, wo),
-        "python-phong": lambda wi=pairs_wi, wo=pairs_wo: run(phong, wi, wo),
-        "_run": run, "_rough": rough, "_phong": phong,
-    }
+    rows = {name: (lambda b=b, wi=pairs_wi, wo=pairs_wo: run(b, wi, wo))
+            for name, b in bsdfs.items()}
+    return rows, run, bsdfs
 
 
 # --------------------------------------------------------------------------- main
@@ -232,8 +277,8 @@ def main(argv=None) -> int:
 
     models = {
         "modified-phong": brdfkit.model("modified-phong", **PHONG),
-        "nielsen": brdfkit.model("nielsen"),
-        "cook-torrance": brdfkit.model("cook-torrance"),
+        "nielsen": brdfkit.model("nielsen", **NIELSEN),
+        "cook-torrance": brdfkit.model("cook-torrance", **COOK),
         "microfacet": brdfkit.model("microfacet", distribution="beckmann", alpha=ALPHA),
     }
     rows = []  # (implementation, model, rate, seconds)
@@ -256,30 +301,27 @@ def main(argv=None) -> int:
     else:
         note = probe_mitsuba_llvm()
     if not note:
-        mit = make_mitsuba(wi, wo)
-        for label, key in (("Mitsuba llvm_ad_rgb", "roughconductor"),
-                           ("Mitsuba llvm_ad_rgb", "python-phong")):
-            rate, t = median_rate(mit[key], n, args.repeats)
-            rows.append((label, key, rate, t))
-        # agreement: Mitsuba returns f_r cos θ_light (3 equal channels)
-        for key, name in (("_rough", "microfacet"), ("_phong", "modified-phong")):
-            fm = mit["_run"](mit[key], wi[:k], wo[:k])[0]
+        mit, run, bsdfs = make_mitsuba(wi, wo)
+        # agreement first: Mitsuba returns f_r cos θ_light (3 equal channels), float32
+        for key, name in (("roughconductor", "microfacet"),
+                          *((v, k) for k, v in TWINS.items())):
+            fm = run(bsdfs[key], wi[:k], wo[:k])[0]
             fb = models[name].eval(wi[:k], wo[:k]) * wi[:k, 2]
             big = fb > 1e-3 * fb.max()
             rel = np.abs(fm[big] - fb[big]) / fb[big]
-            checks.append(f"Mitsuba {'roughconductor' if key == '_rough' else 'python-phong'} "
-                          f"vs brdfkit {name} (x cos): median rel diff {np.median(rel):.1e}, "
-                          f"max {rel.max():.1e}")
+            checks.append(f"Mitsuba {key} vs brdfkit {name} (x cos): median rel diff "
+                          f"{np.median(rel):.1e}, max {rel.max():.1e}")
+        for key in ("roughconductor", *TWINS.values()):
+            rate, t = median_rate(mit[key], n, args.repeats)
+            rows.append(("Mitsuba llvm_ad_rgb", key, rate, t))
 
     rate_of = {(impl.split()[0], name): r for impl, name, r, _ in rows}
-    ratio = {
-        ("brdfkit", "microfacet"): ("Mitsuba", "roughconductor"),
-        ("brdfkit", "modified-phong"): ("Mitsuba", "python-phong"),
-    }
+    ratio = {("brdfkit", "microfacet"): ("Mitsuba", "roughconductor"),
+             **{("brdfkit", k): ("Mitsuba", v) for k, v in TWINS.items()}}
     print()
-    print(f"| {'implementation':<20} | {'model':<16} | {'M evals/s':>9} | {'ns/eval':>7} | "
-          f"{'time (s)':>8} | {'brdfkit/Mitsuba':>15} |")
-    print(f"|{'-' * 22}|{'-' * 18}|{'-' * 11}|{'-' * 9}|{'-' * 10}|{'-' * 17}|")
+    print(f"| {'implementation':<20} | {'model':<20} | {'M evals/s':>9} | {'ns/eval':>7} | "
+          f"{'time (s)':>8} | {'brdfkit/Mitsuba':>20} |")
+    print(f"|{'-' * 22}|{'-' * 22}|{'-' * 11}|{'-' * 9}|{'-' * 10}|{'-' * 22}|")
     for impl, name, rate, t in rows:
         other = ratio.get((impl, name))
         r = ""
@@ -288,8 +330,8 @@ def main(argv=None) -> int:
         elif impl.startswith("Mitsuba"):
             mine = {v: k for k, v in ratio.items()}[(impl.split()[0], name)]
             r = f"(vs {mine[1]})"
-        print(f"| {impl:<20} | {name:<16} | {rate / 1e6:9.1f} | {1e9 / rate:7.1f} | {t:8.3f} | "
-              f"{r:>15} |")
+        print(f"| {impl:<20} | {name:<20} | {rate / 1e6:9.1f} | {1e9 / rate:7.1f} | {t:8.3f} | "
+              f"{r:>20} |")
     print()
     print("load average (1, 5, 15 min): {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     for c in checks:

@@ -79,6 +79,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from brdfkit.analysis._node_pairs import own_loop_evaluator
 from brdfkit.analysis.quadrature import (  # the compiled core
     _KINK_BITS,
     _MODE,
@@ -514,7 +515,11 @@ def albedo(model, theta_i, *, phi=0.0, tol: float = 1e-7, mode: str | None = Non
     phis = (np.zeros(flat.size) if isinstance(model, BRDF) and model.isotropic
             else np.ascontiguousarray(ph.reshape(-1)))
     if isinstance(model, BRDF):
-        if model.kernel is not None:
+        if model._driver is not None and (model.n_channels or 1) > 1:
+            # a model with its own loop over pairs computing every channel in one pass (an
+            # NBRDF net: ~7x the per-channel kernel; a table: one bin search per pair)
+            evaluate, n_channels = own_loop_evaluator(model)
+        elif model.kernel is not None:
             P = np.ascontiguousarray(np.asarray(model.packed, dtype=np.float64))
             nodes = loop_driver(model.kernel, loop="albedo")
 

@@ -59,7 +59,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from brdfkit.analysis.albedo_engine import albedo, check_phi, evaluate_pairs
+from brdfkit.analysis.albedo_engine import check_phi, evaluate_pairs
+from brdfkit.analysis.stored import stored_albedo
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models._base import BRDF
 from brdfkit.status import STATUS
@@ -279,7 +280,7 @@ def check(model, *, tol: float = 1e-7, phi: float = 0.0) -> Verdict:
     else:
         recip = "reciprocal" if asym <= RECIPROCITY_TOL else "not reciprocal"
     grid = np.asarray(ENERGY_GRID_DEG)
-    r = albedo(model, np.radians(grid), phi=phi_at, tol=tol)
+    r = stored_albedo(model, np.radians(grid), phi=phi_at, tol=tol)  # a material: kept on disk
     a = np.asarray(r.albedo).reshape(grid.size, -1)
     err = float(np.max(np.asarray(r.error)))
     notes: list[str] = []
@@ -326,7 +327,7 @@ def check(model, *, tol: float = 1e-7, phi: float = 0.0) -> Verdict:
     if p_est is None and 0 < k < grid.size - 1 and grid[k] < 89.0:
         lo, hi = grid[k - 1], grid[k + 1]
         fine = np.linspace(lo, hi, 13)
-        rf = np.asarray(albedo(model, np.radians(fine), phi=phi_at, tol=tol).albedo
+        rf = np.asarray(stored_albedo(model, np.radians(fine), phi=phi_at, tol=tol).albedo
                         ).reshape(fine.size, -1)
         kf = int(np.argmax(rf.max(axis=1)))
         if rf.max(axis=1)[kf] > max_a:

@@ -1,4 +1,4 @@
-"""Progress on stderr for long commands (``table2``, ``figure``).
+"""Progress on stderr for long commands (``table2``, ``figure``, ``check``, ``render`` …).
 
 Shown only when stderr is a terminal and the command's output is not JSON:
 a pipe, a log file or a ``--json`` consumer sees nothing extra. The display
@@ -11,6 +11,7 @@ Public objects
 - :func:`counter` — context manager yielding a ``progress(done, total, what)``
   callback (or None when progress is off).
 - :func:`status` — context manager printing one "building …" line.
+- :func:`working` — :func:`status` shown when a person watches and the output is not JSON.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from collections.abc import Callable, Iterator
 
 import click
 
-__all__ = ["stderr_is_interactive", "counter", "status"]
+__all__ = ["stderr_is_interactive", "counter", "status", "working"]
 
 
 def stderr_is_interactive() -> bool:
@@ -73,3 +74,12 @@ def status(text: str, *, enabled: bool) -> Iterator[None]:
     finally:
         end = f" done ({time.perf_counter() - t0:.1f} s)" if ok else " failed"
         click.echo(end, err=True)
+
+
+def working(text: str, *, as_json: bool = False):
+    """:func:`status` of *text*, shown when stderr is a terminal and the output is not JSON.
+
+    For a command whose work has no count (one albedo curve, one render, one table)
+    and may take seconds (a material, a pumped or compensated model).
+    """
+    return status(text, enabled=not as_json and stderr_is_interactive())

@@ -151,11 +151,12 @@ def albedo_cmd(model, param, compensate, pump, times, theta, phi, tol, as_json, 
     if as_json and as_csv:
         raise BrdfkitError("give at most one of --json and --csv")
     phi_deg = parse_phi(phi)
-    m = build_model(model, param, pump=pump, times=times, compensate=compensate)
     th = parse_theta(theta)
     if plot:
         check_output_path(plot, option="--plot")  # fail before the quadrature, not after
-    r = albedo(m, np.radians(th), phi=np.radians(phi_deg), tol=tol)
+    with _progress.working(f"albedo of {model}", as_json=as_json):
+        m = build_model(model, param, pump=pump, times=times, compensate=compensate)
+        r = albedo(m, np.radians(th), phi=np.radians(phi_deg), tol=tol)
     d = m.to_dict()
     a = np.asarray(r.albedo)
     e = np.asarray(r.error)
@@ -240,8 +241,9 @@ def check_cmd(model, param, compensate, pump, times, phi, tol, as_json):
     from brdfkit.analysis import check
 
     phi_deg = parse_phi(phi)
-    m = build_model(model, param, pump=pump, times=times, compensate=compensate)
-    v = check(m, phi=np.radians(phi_deg), tol=tol)
+    with _progress.working(f"checking {model}", as_json=as_json):
+        m = build_model(model, param, pump=pump, times=times, compensate=compensate)
+        v = check(m, phi=np.radians(phi_deg), tol=tol)
     d = v.to_dict()
     if as_json:
         emit_json(d)

@@ -16,6 +16,7 @@ import time
 
 import click
 
+import brdfkit.cli._progress as _progress
 from brdfkit._io import check_output_path
 from brdfkit.cli._common import build_model, emit_json, model_options
 from brdfkit.data import material, materials
@@ -43,8 +44,9 @@ def materials_cmd(specs, representations, as_json):
     lobe). MERL data: Matusik et al. 2003, CC-BY-SA-4.0 — keep the
     attribution in derived work.
     """
-    rows = ([material_info(s) for s in specs] if specs
-            else materials(representations=representations))
+    with _progress.working("materials: their albedo a(0)", as_json=as_json):
+        rows = ([material_info(s) for s in specs] if specs
+                else materials(representations=representations))
     if as_json:
         emit_json([r.to_dict() for r in rows])
         return
@@ -75,11 +77,12 @@ def export_cmd(model, param, compensate, pump, times, out, as_json):
     FILE.binary ...' reads it back.
     """
     check_output_path(out, option="--out", suffixes=(".binary",))
-    m = build_model(model, param, pump=pump, times=times, compensate=compensate)
-    t0 = time.perf_counter()
-    path = export_merl(m, out)
-    seconds = time.perf_counter() - t0
-    written = normal_albedo(material(path))
+    with _progress.working(f"exporting {model}", as_json=as_json):
+        m = build_model(model, param, pump=pump, times=times, compensate=compensate)
+        t0 = time.perf_counter()
+        path = export_merl(m, out)
+        seconds = time.perf_counter() - t0
+        written = normal_albedo(material(path))
     lost = _lost_lobe(m, written)
     if lost:
         click.echo(f"brdfkit: warning: {path}: {lost}", err=True)

@@ -20,6 +20,7 @@ import math
 import click
 import numpy as np
 
+import brdfkit.cli._progress as _progress
 from brdfkit import _io
 from brdfkit.cli._common import build_model, build_model_words, emit_json, model_options
 from brdfkit.errors import BrdfkitError
@@ -173,11 +174,13 @@ def sphere_cmd(model, param, compensate, pump, times, phi_l, ambient, irradiance
     if len(compare) > MAX_COMPARE:
         raise BrdfkitError(f"--compare takes at most {MAX_COMPARE} models (one image of "
                            f"{MAX_COMPARE + 1} panels); got {len(compare)}")
-    models = [build_model(model, param, pump, times, compensate),
-              *(build_model_words(c, option="--compare") for c in compare)]
-    results = [render_sphere(m, phi_l=math.radians(phi_l), ambient=ambient,
-                             irradiance=irradiance, size=size, engine=engine, spp=spp,
-                             seed=seed, **aa) for m in models]
+    with _progress.working(f"rendering {model}" + (f" and {len(compare)} more" if compare
+                                                   else ""), as_json=as_json):
+        models = [build_model(model, param, pump, times, compensate),
+                  *(build_model_words(c, option="--compare") for c in compare)]
+        results = [render_sphere(m, phi_l=math.radians(phi_l), ambient=ambient,
+                                 irradiance=irradiance, size=size, engine=engine, spp=spp,
+                                 seed=seed, **aa) for m in models]
     if not all(np.all(np.isfinite(r.radiance)) for r in results):
         raise BrdfkitError(f"the radiance is not finite (it overflows at --irradiance "
                            f"{irradiance:g}, --ambient {ambient:g}); lower them ({out} is not "

@@ -47,7 +47,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from brdfkit._cache import bounded_cache
-from brdfkit.analysis import albedo
+from brdfkit.analysis import albedo, stored
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models import BRDF, DerivedBRDF
 from brdfkit.status import STATUS
@@ -103,6 +103,15 @@ class TransposedBRDF(DerivedBRDF):
                          has_delta=base.has_delta, kernel=kernel,
                          packed=base.packed)
         self.albedo_kinks = base.albedo_kinks
+        self.n_channels = base.n_channels  # a coloured base (a material) stays coloured
+        if base._driver is not None:  # the base's own loop (all channels in one pass), swapped
+            inner = base._driver
+
+            def swapped_driver(wi, wo, data, out):
+                return inner(wo, wi, data, out)
+
+            self._driver = swapped_driver
+            self._driver_data = base._driver_data
 
     def lobes(self):
         return self.base.lobes()
@@ -219,8 +228,9 @@ def ambient_table(model: BRDF, *, theta_max: float, tol: float = RHO_TOL) -> Amb
     Returns
     -------
     AmbientTable
-        Cached per model object: a later call with a *theta_max* and *tol*
-        that an earlier table covers returns it.
+        Kept on disk for a material (:mod:`brdfkit.analysis.stored`: per model numbers,
+        *theta_max*, *tol* and code). Cached per model object: a later call with a
+        *theta_max* and *tol* that an earlier table covers returns it.
 
     Raises
     ------
@@ -251,9 +261,25 @@ def ambient_table(model: BRDF, *, theta_max: float, tol: float = RHO_TOL) -> Amb
     for t in _CACHE.get(model, ()):
         if t.theta_max >= th_max and t.tol <= goal:
             return t
-    table = _build(transposed(model), th_max, goal)
+    key = stored.result_key("ambient", model, th_max, goal) if stored.keeps(model) else None
+    table = _from_disk(key) if key else None
+    if table is None:
+        table = _build(transposed(model), th_max, goal)
+        if key:  # a material's table is kept on disk (brdfkit.analysis.stored)
+            stored.store(key, {"theta": table.theta, "rho": table.rho, "error": table.error,
+                               "tol": table.tol, "status": table.status,
+                               "detail": table.detail})
     _CACHE.setdefault(model, []).append(table)
     return table
+
+
+def _from_disk(key: str) -> AmbientTable | None:
+    hit = stored.load(key)
+    if hit is None or set(hit) != {"theta", "rho", "error", "tol", "status", "detail"}:
+        return None
+    return AmbientTable(theta=hit["theta"], rho=hit["rho"], error=float(hit["error"]),
+                        tol=float(hit["tol"]), status=int(hit["status"]),
+                        detail=str(hit["detail"]))
 
 
 def _build(target: BRDF, th_max: float, goal: float) -> AmbientTable:
