@@ -195,7 +195,7 @@ def test_check_and_table2_of_the_walter_file():
     assert ours["reciprocity"] == theirs["reciprocity"] == "reciprocal"
     assert ours["energy"] == theirs["energy"] == "conserves"
     assert ours["max_albedo"] == pytest.approx(theirs["max_albedo"], abs=1e-6)
-    (row,) = ok_json("table2", "--model", WALTER)
+    (row,) = ok_json("table2", WALTER)
     assert row["row"] == "walter_ggx.brdf" and row["model"] == str(WALTER)
     assert row["energy"] == "conserves" and row["reciprocity"] == "reciprocal"
     # the file's default α = 0.1: the registered model's verdict at α = 0.1
@@ -218,7 +218,7 @@ def test_check_phi_of_the_anisotropic_file():
 # --------------------------------------------------------------------------- figure, export
 def test_figure_slices_of_files(tmp_path):
     out = tmp_path / "s.png"
-    r = run("figure", "slices", "--model", WARD, "--compare", WALTER, "--out", out)
+    r = run("figure", "slices", WARD, "--compare", WALTER, "--out", out)
     assert r.exit_code == 0, r.output
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
@@ -306,7 +306,7 @@ def test_pumping_a_file_is_pumping_the_registered_model(tmp_path):
         assert r.exit_code == 0, r.output
     np.testing.assert_allclose(np.load(a), np.load(b), rtol=1e-6, atol=1e-12)
     out = tmp_path / "p.png"
-    assert run("figure", "slices", "--model", WALTER, "--pump", "max", "--out", out).exit_code == 0
+    assert run("figure", "slices", WALTER, "--pump", "max", "--out", out).exit_code == 0
     x1, x2 = (ok_json("export", *m, "--out", tmp_path / f"{k}.binary")
               for k, m in (("a", ours_m), ("b", theirs_m)))
     assert x1["pump"] == {"g": "max", "times": 1}

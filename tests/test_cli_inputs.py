@@ -371,17 +371,17 @@ def test_table2_progress_callback_does_not_change_rows():
 
 def test_table2_progress_on_interactive_stderr_only(monkeypatch):
     monkeypatch.setattr(_progress, "stderr_is_interactive", lambda: True)
-    r = run("table2", "--model", "lambert")
+    r = run("table2", "lambert")
     assert r.exit_code == 0
     assert "table2: 0/1 lambert" in r.stderr and r.stderr.endswith("\r")  # line erased at end
     assert "\r" not in r.stdout and "0/1" not in r.stdout  # progress never goes to stdout
-    r = run("table2", "--model", "lambert", "--json")
+    r = run("table2", "lambert", "--json")
     assert r.exit_code == 0 and r.stderr == ""  # never with --json
     json.loads(r.stdout)
 
 
 def test_no_progress_when_not_interactive():
-    r = run("table2", "--model", "lambert")  # CliRunner's stderr is not a terminal
+    r = run("table2", "lambert")  # CliRunner's stderr is not a terminal
     assert r.exit_code == 0 and r.stderr == ""
 
 
@@ -401,7 +401,7 @@ def test_figure_building_line_when_interactive(monkeypatch, tmp_path):
                                             "options": {}})]
     # a Monte-Carlo figure gets its options and draws its own progress bar (no building line)
     written.clear()
-    r = run("figure", "neumann-fig8", "--spp", "4", "--size", "32", "--out", out)
+    r = run("figure", "neumann-fig8", "--spp", "4", "--panel-size", "32", "--out", out)
     assert r.exit_code == 0, r.stderr
     assert "building" not in r.stderr
     assert written == [("neumann-fig8", out, {"dpi": 150, "option": "--out", "models": (),

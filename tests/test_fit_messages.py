@@ -46,3 +46,30 @@ def test_a_fit_to_its_own_model_is_not_flagged():
     # its albedo is the target's (the same formula), to the rule's error
     np.testing.assert_allclose(r.albedo_model, r.albedo_target, rtol=0.05)
     assert math.isfinite(r.value)
+
+
+def test_a_conductor_fit_trading_eta_for_k_says_so():
+    # issue 20: fit microfacet --to merl:nickel --start eta=1.5 ends at eta ~ 23 with k at
+    # its lower bound, a dielectric Fresnel of equal F0 imitating a metal. A fast case of
+    # the same trade-off: a GGX conductor (eta = 1.5, k = 3) as the target, rho_s held at 1
+    # so that only the Fresnel factor can carry the reflectance. F0 by the closed form
+    # F0 = ((eta - 1)^2 + k^2)/((eta + 1)^2 + k^2) (Born & Wolf; normal incidence).
+    def f0(eta, k):
+        return ((eta - 1.0) ** 2 + k ** 2) / ((eta + 1.0) ** 2 + k ** 2)
+
+    target = brdfkit.model("microfacet", distribution="ggx", alpha=0.2, eta=1.5, k=3.0)
+    r = fit(brdfkit.model("microfacet", distribution="ggx", eta=1.5), target,
+            fixed={"rho_s": 1.0}, n_starts=1)
+    eta, k = float(r.params["eta"]), float(r.params["k"])
+    # the trade-off itself: far from the target's (eta, k), at nearly its F0
+    assert eta > 3.0 and k < 1e-3
+    assert abs(f0(eta, k) - f0(1.5, 3.0)) < 0.05
+    assert (f"eta = {eta:.3g} with k at its lower bound: F0 = {f0(eta, k):.3g}"
+            in r.message), r.message
+    assert "nearly interchangeable at equal F0" in r.message
+    assert "hold one (-p k=VALUE or -p eta=VALUE)" in r.message
+    # k held (a dielectric fit): eta alone is read, no trade-off to note
+    held = fit(brdfkit.model("microfacet", distribution="ggx", eta=1.5), target,
+               fixed={"rho_s": 1.0, "k": 0.0}, n_starts=1)
+    assert float(held.params["eta"]) > 3.0, held.params
+    assert "interchangeable" not in held.message, held.message

@@ -152,9 +152,9 @@ def nielsen_report(tmp_path_factory):
     try:
         # two workers: the process pool's path (the re-run below reads the cache)
         res = CliRunner().invoke(main, ["reproduce", "--only", "nielsen", "--out", str(out),
-                                        "--jobs", "2"])
+                                        "--workers", "2"])
         again = CliRunner().invoke(main, ["reproduce", "--only", "nielsen", "--out",
-                                          str(out), "--jobs", "1"])
+                                          str(out), "--workers", "1"])
     finally:
         if old is None:
             os.environ.pop("BRDFKIT_CACHE_DIR")
@@ -202,7 +202,7 @@ def test_a_failing_item_is_reported_and_the_run_goes_on(tmp_path, monkeypatch):
                                              "nielsen": claims_nielsen.CLAIMS})
     monkeypatch.setenv("BRDFKIT_CACHE_DIR", str(tmp_path / "cache"))
     res = CliRunner().invoke(main, ["reproduce", "--only", "nielsen", "--out",
-                                    str(tmp_path / "r"), "--jobs", "1"])
+                                    str(tmp_path / "r"), "--workers", "1"])
     assert res.exit_code == 1
     assert f"failed: claim {c.id}: ZeroDivisionError: provoked by the test" in res.output
     data = json.loads((tmp_path / "r" / "claims.json").read_text(encoding="utf-8"))
@@ -214,7 +214,7 @@ def test_a_failing_item_is_reported_and_the_run_goes_on(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("args, message", [
     (["--only", "smith"], "Invalid value for '--only'"),
-    (["--jobs", "0"], "--jobs"),
+    (["--workers", "0"], "--workers"),
     (["--study-dir", "/nonexistent/dir"], "--study-dir must be a directory"),
 ])
 def test_bad_input_is_one_line_exit_2(tmp_path, args, message):

@@ -86,7 +86,7 @@ def test_cli_unknown_spec_one_line():
 
 
 def test_table2_row_for_a_material():
-    r = run("table2", "--model", "merl:violet-rubber@abc", "--model", "lambert", "--json")
+    r = run("table2", "merl:violet-rubber@abc", "lambert", "--json")
     assert r.exit_code == 0, r.output
     rows = {row["row"]: row for row in json.loads(r.stdout)}
     mat = rows["merl:violet-rubber@abc"]
@@ -179,10 +179,10 @@ def test_export_of_a_file_is_bit_exact_and_errors(tmp_path):
 # --------------------------------------------------------------------------- figure
 def test_figure_slices_of_a_model(tmp_path):
     out = tmp_path / "s.png"
-    r = run("figure", "slices", "--model", "lambert", "--compare", "modified-phong",
+    r = run("figure", "slices", "lambert", "--compare", "modified-phong",
             "--out", out)
     assert r.exit_code == 0, r.output
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    one_line_error(run("figure", "slices", "--out", out), "--model")
-    one_line_error(run("figure", "lewis-fig5", "--model", "lambert", "--out", out),
+    one_line_error(run("figure", "slices", "--out", out), "draws a given model")
+    one_line_error(run("figure", "lewis-fig5", "lambert", "--out", out),
                    "takes no model")

@@ -47,12 +47,12 @@ def test_formats(rows):
 
 
 def test_cli_table2_json_subset():
-    r = CliRunner().invoke(main, ["table2", "--json", "--model", "minnaert"])
+    r = CliRunner().invoke(main, ["table2", "--json", "minnaert"])
     assert r.exit_code == 0, r.output
     d = json.loads(r.output)
     assert d[0]["model"] == "minnaert" and d[0]["agrees_with_paper"] is True
 
 
 def test_cli_table2_exclusive_flags():
-    r = CliRunner().invoke(main, ["table2", "--json", "--markdown", "--model", "lambert"])
+    r = CliRunner().invoke(main, ["table2", "--json", "--markdown", "lambert"])
     assert r.exit_code == 2

@@ -537,9 +537,9 @@ def test_cli_commands_take_a_python_model(files, tmp_path):
     assert np.allclose(json.loads(r.output)["albedo"], 0.8, atol=1e-9)
     r = run("check", m, "--json")
     assert r.exit_code == 0 and json.loads(r.output)["reciprocity"] == "reciprocal"
-    r = run("table2", "--model", m, "--json")
+    r = run("table2", m, "--json")
     assert r.exit_code == 0 and json.loads(r.output)[0]["row"].startswith("models.py:")
-    r = run("figure", "slices", "--model", m, "--out", tmp_path / "s.png")
+    r = run("figure", "slices", m, "--out", tmp_path / "s.png")
     assert r.exit_code == 0 and (tmp_path / "s.png").stat().st_size > 0, r.output
     r = run("export", spec(files, "lambert"), "--out", tmp_path / "l.binary")
     assert r.exit_code == 0, r.output

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import shlex
 from collections.abc import Callable, Iterable, Mapping
 
@@ -49,9 +50,13 @@ __all__ = [
     "PUMP_MAX_TIMES",
     "THETA_MAX_DEG",
     "model_options",
+    "model_word_options",
+    "deprecated_alias",
+    "model_entry",
     "parse_param_items",
     "build_model",
     "build_model_words",
+    "split_model_words",
     "parse_direction",
     "to_jsonable",
     "emit_json",
@@ -117,6 +122,76 @@ def build_model_words(text: str, *, option: str = "--compare"):
     """Build the model of one quoted option value written as a command line writes MODEL:
     ``'SPEC [-p NAME=VALUE]... [--compensate M] [--pump G [--times K]]'`` (shell quoting);
     a bare spec is the model at its defaults. Errors name *option* and the word."""
+    return build_model(*split_model_words(text, option=option))
+
+
+def model_entry(text: str, params=(), pump=None, times=None, compensate=None, *,
+                option: str = "SPEC") -> dict:
+    """The :class:`~brdfkit.spec.ModelSpec` dict form of *text* (a spec, or quoted model
+    words as --compare takes them) with the further words given, checked (the model is
+    built): ``{"model", "params", ["compensate"], ["pump"]}``."""
+    spec, p, g, k, c = split_model_words(text, option=option)
+    g, k, c = g or pump, k if k is not None else times, c or compensate
+    built = ModelSpec.parse(spec, [*p, *params], pump=g, times=k, compensate=c)
+    built.build()
+    return built.to_dict()
+
+
+def _times_callback(ctx: click.Context, param: click.Parameter, value):
+    problem = None if value is None else times_problem(value)
+    if problem is not None:
+        raise click.BadParameter(problem, ctx=ctx, param=param)
+    return value
+
+
+def deprecated_alias(old: str, dest: str, instead: str, **kwargs) -> Callable:
+    """A hidden option *old* kept for scripts written before the one vocabulary
+    (docs/cli.md): it still works, stores into *dest*'s ``_old`` twin (the command merges
+    it) and prints one line ``brdfkit: note: OLD is deprecated; INSTEAD`` on stderr."""
+    def note(ctx, param, value):
+        if value not in (None, (), False):
+            click.echo(f"brdfkit: note: {old} is deprecated; {instead}", err=True)
+        return value
+    return click.option(old, dest, hidden=True, callback=note, expose_value=True,
+                        **kwargs)
+
+
+def model_word_options(func: Callable) -> Callable:
+    """Decorator adding ``-p/--param``, ``--compensate``, ``--pump`` and ``--times`` (the
+    words that describe a model) without the argument itself (:func:`model_options` adds
+    it too)."""
+    func = click.option("--times", type=int, default=None, callback=_times_callback,
+                        metavar="K",
+                        help=f"Apply the pumping K times (needs --pump; 1 to {PUMP_MAX_TIMES}, "
+                             f"default 1; {_TIMES_REASON}).")(func)
+    func = click.option("--pump", type=click.Choice(list(PUMP_CHOICES)), default=None,
+                        help="Pump up the albedo (Neumann et al. 1999, eqs. 16-21) with "
+                             "g1 ('max') or g2 ('controlled').")(func)
+    func = click.option("--compensate", type=click.Choice(list(COMPENSATE_CHOICES)),
+                        default=None, help=COMPENSATE_HELP)(func)
+    func = click.option("-p", "--param", "param", multiple=True, metavar="NAME=VALUE",
+                        help=PARAM_HELP)(func)
+    return func
+
+
+def model_options(func: Callable) -> Callable:
+    """Decorator adding ``MODEL``, ``-p/--param``, ``--compensate``, ``--pump`` and
+    ``--times`` to a command.
+
+    The command receives ``model`` (str), ``param`` (tuple of str), ``compensate`` (str or
+    None), ``pump`` (str or None) and ``times`` (int, or None when not given); pass them to
+    :func:`build_model`.
+    """
+    func = model_word_options(func)
+    func = click.argument("model", metavar="MODEL")(func)
+    return func
+
+
+def split_model_words(text: str, *, option: str = "--compare"):
+    """``'SPEC [-p NAME=VALUE]... [--compensate M] [--pump G [--times K]]'`` → (spec,
+    params, pump, times, compensate), as :func:`build_model_words` reads it."""
+    if os.path.exists(str(text)):  # a file whose path has spaces is one spec
+        return str(text), [], None, None, None
     try:
         words = shlex.split(str(text))
     except ValueError as exc:
@@ -145,37 +220,7 @@ def build_model_words(text: str, *, option: str = "--compare"):
         except ValueError:
             raise BrdfkitError(f"{option} {text!r}: --times must be a whole number; got "
                                f"{times!r}") from None
-    return build_model(target, params, ops.get("pump"), times, ops.get("compensate"))
-
-
-def _times_callback(ctx: click.Context, param: click.Parameter, value):
-    problem = None if value is None else times_problem(value)
-    if problem is not None:
-        raise click.BadParameter(problem, ctx=ctx, param=param)
-    return value
-
-
-def model_options(func: Callable) -> Callable:
-    """Decorator adding ``MODEL``, ``-p/--param``, ``--compensate``, ``--pump`` and
-    ``--times`` to a command.
-
-    The command receives ``model`` (str), ``param`` (tuple of str), ``compensate`` (str or
-    None), ``pump`` (str or None) and ``times`` (int, or None when not given); pass them to
-    :func:`build_model`.
-    """
-    func = click.option("--times", type=int, default=None, callback=_times_callback,
-                        metavar="K",
-                        help=f"Apply the pumping K times (needs --pump; 1 to {PUMP_MAX_TIMES}, "
-                             f"default 1; {_TIMES_REASON}).")(func)
-    func = click.option("--pump", type=click.Choice(list(PUMP_CHOICES)), default=None,
-                        help="Pump up the albedo (Neumann et al. 1999, eqs. 16-21) with "
-                             "g1 ('max') or g2 ('controlled').")(func)
-    func = click.option("--compensate", type=click.Choice(list(COMPENSATE_CHOICES)),
-                        default=None, help=COMPENSATE_HELP)(func)
-    func = click.option("-p", "--param", "param", multiple=True, metavar="NAME=VALUE",
-                        help=PARAM_HELP)(func)
-    func = click.argument("model", metavar="MODEL")(func)
-    return func
+    return target, params, ops.get("pump"), times, ops.get("compensate")
 
 
 # --------------------------------------------------------------------------- directions

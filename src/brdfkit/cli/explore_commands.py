@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import click
 
+from brdfkit.cli._common import model_entry, model_word_options
+from brdfkit.errors import BrdfkitError
 from brdfkit.explorer.serve import DEFAULT_PORT, LOCALHOST, serve
 from brdfkit.explorer.worker import BUDGET_S
 
@@ -16,7 +18,8 @@ __all__ = ["explore_cmd"]
 
 
 @click.command("explore")
-@click.argument("specs", nargs=-1, metavar="[SPEC]...")
+@click.argument("specs", nargs=-1, metavar="[MODEL]...")
+@model_word_options
 @click.option("--port", type=click.IntRange(1, 65535), default=DEFAULT_PORT, show_default=True,
               help="TCP port.")
 @click.option("--host", default=LOCALHOST, show_default=True,
@@ -32,11 +35,15 @@ __all__ = ["explore_cmd"]
               show_default=True, metavar="SECONDS",
               help="Time one request may compute; a model over it shows an error in the "
                    "page (the computation is stopped).")
-def explore_cmd(specs, port, host, no_browser, allow_dirs, budget):
+def explore_cmd(specs, param, compensate, pump, times, port, host, no_browser, allow_dirs,
+                budget):
     """Open the explorer: models, pumped models and materials side by side in a browser.
 
-    SPEC... are the models shown first (model names, material specs such as
-    merl:nickel, or files: my.brdf, model.py[:NAME], a MERL .binary); more can be
+    MODEL... are the models shown first (model names, material specs such as
+    merl:nickel, or files: my.brdf, model.py[:NAME], a MERL .binary); -p, --compensate,
+    --pump and --times set the one MODEL's parameters and operators (with several,
+    quote each with its own words as --compare takes them, e.g. 'nielsen -p k_s=5'
+    merl:nickel). More can be
     added in the page, a file by its path ("open file"). A file shown is watched:
     saving an edit redraws it within a second, keeping the parameter values the
     new version still has; a broken edit shows its error beside the last good
@@ -48,5 +55,16 @@ def explore_cmd(specs, port, host, no_browser, allow_dirs, budget):
     only requests addressed to this server from its own page, computes each request
     for at most --budget seconds in a worker process; Ctrl-C stops it at once.
     """
-    serve(specs=specs, host=host, port=port, open_browser=not no_browser,
+    words = bool(param or compensate or pump or times is not None)
+    if words and len(specs) != 1:
+        raise BrdfkitError("-p, --compensate, --pump and --times describe one MODEL; got "
+                           f"{len(specs)} (quote each model with its own words instead, e.g. "
+                           "brdfkit explore 'nielsen -p k_s=5' merl:nickel)")
+    entries = [model_entry(s, param, pump, times, compensate, option="MODEL") for s in specs]
+    if not words and all(set(e) == {"model", "params"} and not e["params"]
+                         for e in entries):
+        entries = None  # the short state #m=SPEC,... (the page's defaults)
+    else:
+        specs = [e["model"] for e in entries]
+    serve(specs=specs, models=entries, host=host, port=port, open_browser=not no_browser,
           allow_dirs=allow_dirs, budget_s=budget, log=lambda s: click.echo(s, err=True))

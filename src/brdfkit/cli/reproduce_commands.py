@@ -13,6 +13,7 @@ import time
 
 import click
 
+from brdfkit.cli._common import deprecated_alias
 from brdfkit.cli._progress import stderr_is_interactive
 
 __all__ = ["reproduce_cmd", "progress_printer"]
@@ -59,13 +60,15 @@ def progress_printer(*, interactive: bool):
 @click.option("--full", is_flag=True, default=False,
               help="Refit all 100 MERL materials (resumable, under DIR/fitting-study) and "
                    "render at paper quality; default: the shipped study batches, previews.")
-@click.option("--jobs", type=click.IntRange(min=1, max=256), default=None, metavar="N",
-              help="Worker processes (default: the number of CPUs).")
+@click.option("--workers", "jobs", type=click.IntRange(min=1, max=256), default=None,
+              metavar="N", help="Worker processes (default: the number of CPUs).")
+@deprecated_alias("--jobs", "jobs_old", "use --workers (as fit names it)",
+                  type=click.IntRange(min=1, max=256))
 @click.option("--study-dir", default=None, metavar="DIR",
               help="The fitting study's batch directory (default: the shipped batches).")
 @click.option("--no-cache", is_flag=True, default=False,
               help="Compute every item again (and do not store the results).")
-def reproduce_cmd(out, only, full, jobs, study_dir, no_cache):
+def reproduce_cmd(out, only, full, jobs, jobs_old, study_dir, no_cache):
     """Recompute every figure, table and claim of Lewis 1993, Neumann et al. 1999 and
     Nielsen et al. 2015 into one report (open DIR/index.html).
 
@@ -82,7 +85,7 @@ def reproduce_cmd(out, only, full, jobs, study_dir, no_cache):
     if study_dir is not None and not os.path.isdir(study_dir):
         raise BrdfkitError(f"--study-dir must be a directory of fitting-study batches; "
                            f"{study_dir!r} is not a directory")
-    jobs = jobs or max(1, os.cpu_count() or 1)
+    jobs = jobs or jobs_old or max(1, os.cpu_count() or 1)
     progress = progress_printer(interactive=stderr_is_interactive())
     run = reproduce(out, only=only, full=full, jobs=jobs, study_dir=study_dir,
                     use_cache=not no_cache, progress=progress)

@@ -30,11 +30,21 @@ DEFAULT_PORT = 8765
 LOCALHOST = "127.0.0.1"
 
 
-def start_url(host: str, port: int, specs=()) -> str:
+def start_url(host: str, port: int, specs=(), models=None) -> str:
     """The page's address, with *specs* as the initial models in the short URL state
     ``#m=SPEC,SPEC`` (each spec percent-encoded, a comma too), which the page expands to
-    its full state (the models at their defaults)."""
+    its full state (the models at their defaults); with *models* (ModelSpec dict forms:
+    parameters, pumping, compensation) the full state ``#{"models": [...]}`` instead."""
     url = f"http://{host}:{port}/"
+    if models:
+        import json
+
+        entries = [{"spec": d["model"], "params": d.get("params", {}),
+                    "compensate": (d.get("compensate") or {}).get("method"),
+                    "pump": (d.get("pump") or {}).get("g"),
+                    "times": (d.get("pump") or {}).get("times", 1), "visible": True}
+                   for d in models]
+        return url + "#" + urllib.parse.quote(json.dumps({"models": entries}), safe="")
     if specs:
         url += "#m=" + ",".join(urllib.parse.quote(str(s), safe="") for s in specs)
     return url
@@ -54,10 +64,12 @@ def _check_free(host: str, port: int) -> None:
                            "--port, or stop the program using it)") from None
 
 
-def serve(*, specs=(), host: str = LOCALHOST, port: int = DEFAULT_PORT, open_browser: bool = True,
-          allow_dirs=(), budget_s: float | None = None, log=print) -> None:
+def serve(*, specs=(), models=None, host: str = LOCALHOST, port: int = DEFAULT_PORT,
+          open_browser: bool = True, allow_dirs=(), budget_s: float | None = None,
+          log=print) -> None:
     """Serve until Ctrl-C. *specs* (model names or material specs) are validated first;
-    *allow_dirs* must be directories."""
+    *allow_dirs* must be directories. *models* (ModelSpec dict forms of *specs*, with their
+    parameters and operators) open them so (:func:`start_url`)."""
     import os
 
     import uvicorn
@@ -76,7 +88,7 @@ def serve(*, specs=(), host: str = LOCALHOST, port: int = DEFAULT_PORT, open_bro
     for s in specs:
         canonical_name(s)  # an unknown spec fails here, with the dispatcher's did-you-mean message
     _check_free(host, port)
-    url = start_url(host, port, specs)
+    url = start_url(host, port, specs, models)
     where = ("this machine only" if host == LOCALHOST else
              f"every machine that can reach {host} (--host given)")
     log(f"brdfkit explore: serving on {url} ({where}); Ctrl-C stops")

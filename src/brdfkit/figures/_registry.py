@@ -45,8 +45,8 @@ FIGURES: Mapping[str, Callable] = MappingProxyType({
     "energy-reciprocity": energy.energy_reciprocity,
 })
 
-#: name → the keyword options a figure takes (Monte-Carlo renders: the CLI's --spp, --size,
-#: --seed); figures not listed take none.
+#: name → the keyword options a figure takes (rendered panels: the CLI's --spp, --panel-size
+#: (size), --seed); figures not listed take none.
 FIGURE_OPTIONS: Mapping[str, tuple[str, ...]] = MappingProxyType({
     "neumann-fig8": ("spp", "size", "seed"),
     "nielsen-fig1": ("size",),
@@ -89,7 +89,7 @@ def make_figure(name: str, models=(), **options):
     if key in MODEL_FIGURES:
         if not models:
             raise BrdfkitError(f"figure {key} draws given models: pass at least one model "
-                               f"(the CLI's --model SPEC)")
+                               f"(the CLI: brdfkit figure {key} MODEL)")
         return MODEL_FIGURES[key](*models)
     if models:
         raise BrdfkitError(f"figure {key} reproduces a paper figure with its own models; it "

@@ -8,7 +8,7 @@ Figures of any model or material
   version).
 
 Unlike the paper figures these take the models to draw: ``brdfkit figure
-slices --model merl:nickel [--compare nielsen -p ...] --out FILE``.
+slices merl:nickel [--compare nielsen -p ...] --out FILE``.
 """
 
 from __future__ import annotations

@@ -29,6 +29,7 @@ from brdfkit.fitting._records import AtBound, Convergence
 from brdfkit.fitting._space import BOUND_LOSS_RTOL
 from brdfkit.fitting.losses import REGISTRY
 from brdfkit.fitting.samples import ALBEDO_NODES, ALBEDO_THETA_DEG, albedo_nodes, albedo_with_error
+from brdfkit.fresnel import fresnel_conductor
 from brdfkit.models import BRDF
 from brdfkit.status import STATUS
 
@@ -154,6 +155,32 @@ def _inert(space, values, flat) -> list[tuple[str, float, float, float]]:
             if flat.get(c.label, ("",))[0] == "inert"]
 
 
+def eta_k_note(model, space, at_bounds) -> str:
+    """The note of a fit whose Fresnel index η and extinction κ were both fitted and one of
+    them ended at a bound: for a conductor only F(θ) is observable, and (η, κ) pairs of
+    equal F₀ = ((η − 1)² + κ²)/((η + 1)² + κ²) give nearly the same F(θ), so the fit may
+    trade one for the other (merl:nickel: η ≈ 23 with κ at 0, a dielectric-like Fresnel
+    with F₀ ≈ 0.85 imitating a metal). The values are then not the material's (η, κ); the
+    note gives the F₀ they do determine. "" when it does not apply."""
+    free = {c.name for c in space.coords}
+    bounded = {b.parameter.split("[")[0] for b in at_bounds}
+    values = model.to_dict()["params"]
+    eta, k = values.get("eta"), values.get("k")
+    if not {"eta", "k"} <= free or not bounded & {"eta", "k"} or eta is None or k is None:
+        return ""
+    f0 = np.atleast_1d(fresnel_conductor(1.0, eta, k))
+    which = next(b for b in at_bounds if b.parameter.split("[")[0] in ("eta", "k"))
+    name = which.parameter.split("[")[0]
+    other = "eta" if name == "k" else "k"
+
+    def fmt(v):
+        return "/".join(f"{x:.3g}" for x in np.atleast_1d(v))
+    return (f"{other} = {fmt(values[other])} with {name} at its {which.bound} bound: "
+            f"F0 = {fmt(f0)}; a conductor's (eta, k) are nearly interchangeable at "
+            "equal F0 = ((eta-1)^2+k^2)/((eta+1)^2+k^2), so these are not the material's; "
+            "hold one (-p k=VALUE or -p eta=VALUE) to read the other")
+
+
 def _status(pred, value, hit_limit, at_bounds) -> int:
     if not np.all(np.isfinite(pred)) or not math.isfinite(value):
         return FIT_STATUS.NONFINITE
@@ -199,6 +226,9 @@ def make_result(prob, target, space, values, record: Convergence, hit_limit, t_s
                 f"{BOUND_LOSS_RTOL:g} relative: the data do not determine it, e.g. the shape "
                 "of a lobe of zero weight): " + ", ".join(
                     f"{label} = {x:.4g} in [{lo:g}, {hi:g}]" for label, x, lo, hi in inert))
+    trade = eta_k_note(m, space, at_bounds)
+    if trade:
+        msg += "; " + trade
     far = albedo_far(ALBEDO_THETA_DEG, a_m, a_t, rel)
     if far:
         msg += "; " + far
