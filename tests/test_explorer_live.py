@@ -335,7 +335,7 @@ def test_page_reloads_a_saved_file_within_a_second(browser, server, tmp_path):
         staged = tmp_path / "staged.binary"
         _lambert_binary(staged, rho)
         _wait_verdict(page)  # the latency of a reload, not of a verdict still computing
-        polar0 = page.evaluate("document.getElementById('polar').toDataURL()")
+        polar0 = page.evaluate("drawnData('polar')")
         t0 = time.perf_counter()
         os.replace(staged, p)  # the save (an editor's atomic rename)
         page.wait_for_function(f"Math.abs(({SLICE0})(0) - {rho / math.pi!r}) < 1e-9",
@@ -343,7 +343,7 @@ def test_page_reloads_a_saved_file_within_a_second(browser, server, tmp_path):
         latencies.append(time.perf_counter() - t0)
         # drawn: the polar plot's scale ("max ...") moved with ρ (the sphere is exposed to
         # its brightest pixel, so a Lambertian sphere looks the same at every ρ)
-        assert page.evaluate("document.getElementById('polar').toDataURL()") != polar0
+        assert page.evaluate("drawnData('polar')") != polar0
     print(f"reload latency (save → new values in the page): {latencies} s")
     # the best of three saves within a second, every one within 3 s: the machine is shared
     # (2 cores, several test runs), a save can wait for the scheduler. Measured here:

@@ -62,10 +62,11 @@ def serve(*, specs=(), host: str = LOCALHOST, port: int = DEFAULT_PORT, open_bro
 
     import uvicorn
 
-    from brdfkit.explorer.app import create_app
+    from brdfkit.explorer.app import create_app, plotly_js
     from brdfkit.explorer.worker import BUDGET_S, SHUTDOWN_GRACE_S
     from brdfkit.spec import canonical_name
 
+    plotly_js()  # the page's plots: a missing plotly package is one line, before serving
     for d in allow_dirs:
         if not os.path.isdir(d):
             raise BrdfkitError(f"--allow-dir {d}: not a directory (give a directory whose "
