@@ -120,12 +120,15 @@ function drawLobe(el, s, items) {
     traces.push({ type: "scatter3d", mode: "lines", x: [0, wi[0]], y: [0, wi[1]], z: [0, wi[2]],
                   name: "light ω_i", hoverinfo: "name", line: { color: LIGHT_COLOUR, width: 6 } });
   }
-  const axis = (t, r) => ({ title: { text: t }, range: r, dtick: 0.5, zeroline: false });
+  // no tick at the scene's corners, where the x, y and z labels would meet
+  const axis = (t, r, ticks) => ({ title: { text: t }, range: r, tickvals: ticks, zeroline: false });
+  const flat = [-0.5, 0, 0.5];
   Plotly.react(el, traces, baseLayout({
     margin: { l: 0, r: 0, t: 0, b: 0 },
-    scene: { xaxis: axis("x", [-1, 1]), yaxis: axis("y", [-1, 1]), zaxis: axis("z (normal)", [0, 1]),
+    scene: { xaxis: axis("x", [-1, 1], flat), yaxis: axis("y", [-1, 1], flat),
+             zaxis: axis("z (normal)", [0, 1], [0.5, 1]),
              aspectmode: "manual", aspectratio: { x: 1, y: 1, z: 0.5 },
-             camera: { eye: { x: 1.2, y: -1.5, z: 0.9 } } },
+             camera: { eye: { x: 0.95, y: -1.2, z: 0.7 } } },
   }), CONFIG);
 }
 
