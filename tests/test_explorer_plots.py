@@ -140,6 +140,12 @@ def test_every_view_is_a_plotly_figure(page):
     # the lobe: a WebGL 3-D scene of one surface per model and the light's direction
     assert figs["lobe"]["type"] == ["surface", "surface", "scatter3d"]
     assert page.locator("#lobe .gl-container div[id^='scene'] canvas").count() >= 1
+    # its render loop (~20% of a core with software WebGL) runs only under the pointer
+    assert page.evaluate("glplotOf(document.getElementById('lobe'))._stopped") is True
+    page.hover("#lobe")
+    page.wait_for_function("glplotOf(document.getElementById('lobe'))._stopped === false")
+    page.mouse.move(0, 0)
+    page.wait_for_function("glplotOf(document.getElementById('lobe'))._stopped === true")
     # one θ_h × θ_d figure per model, each an image with a colour bar
     assert page.locator("#halfdiffs .js-plotly-plot").count() == len(MODELS)
     assert page.locator("#halfdiffs .colorbar").count() == len(MODELS)

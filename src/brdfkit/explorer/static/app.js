@@ -550,6 +550,7 @@ async function init() {
       });
     });
   }
+  liveWhileHovered(document.getElementById("lobe"));
   update();
   pollChanges();
 }

@@ -101,8 +101,36 @@ function scheduleLobe(el, s, items) {
     lobeDue = null;
     const t0 = performance.now();
     drawLobe(e, st, it);
+    renderOnce(e);
     lobeMs = performance.now() - t0;
   }, 0);
+}
+
+// Plotly's WebGL scene re-checks itself every animation frame for as long as it exists: ~20%
+// of a core measured with software rendering (a headless browser), taken from the server on
+// a small machine. The loop runs only while the pointer is over the lobe (to rotate and
+// zoom it); otherwise the scene is rendered once per drawing. Plotly's internal scene
+// object (_fullLayout.scene._scene.glplot, plotly.js 3); without it the loop just runs.
+function glplotOf(el) {
+  const sc = el._fullLayout && el._fullLayout.scene && el._fullLayout.scene._scene;
+  return sc && sc.glplot && typeof sc.glplot.redraw === "function" ? sc.glplot : null;
+}
+
+function renderOnce(el) {
+  const gp = glplotOf(el);
+  if (!gp || el.dataset.live === "1") return;
+  gp._stopped = false; gp.redraw(); gp._stopped = true;
+}
+
+function liveWhileHovered(el) {
+  el.addEventListener("mouseenter", () => {
+    const gp = glplotOf(el);
+    if (!gp) return;
+    el.dataset.live = "1"; gp._stopped = false;
+    const loop = () => { if (el.dataset.live === "1" && !gp._stopped) { gp.redraw(); requestAnimationFrame(loop); } };
+    requestAnimationFrame(loop);
+  });
+  el.addEventListener("mouseleave", () => { el.dataset.live = "0"; renderOnce(el); });
 }
 
 function drawLobe(el, s, items) {
