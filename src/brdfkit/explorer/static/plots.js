@@ -149,6 +149,9 @@ function drawLobe(el, s, items) {
                   name: "light ω_i", hoverinfo: "name", line: { color: LIGHT_COLOUR, width: 6 } });
   }
   // no tick at the scene's corners, where the x, y and z labels would meet
+  // another number of models: a new scene (Plotly's WebGL scene updated in place with
+  // surfaces added or removed renders a disposed shader: "this._relink is not a function")
+  if (el.data && el.data.length !== traces.length) Plotly.purge(el);
   const axis = (t, r, ticks) => ({ title: { text: t }, range: r, tickvals: ticks, zeroline: false });
   const flat = [-0.5, 0, 0.5];
   Plotly.react(el, traces, baseLayout({
