@@ -123,14 +123,14 @@ def test_page_loads_and_updates(browser, server, tmp_path):
     page, errors = open_page(browser, _url(server, [{"spec": "modified-phong", "params": {}}]))
     assert errors == []
     sphere0 = page.locator("#spheres img").first.get_attribute("src")
-    albedo0 = page.evaluate("document.getElementById('albedo').toDataURL()")
+    albedo0 = page.evaluate("drawnData('albedo')")
     n = page.locator("#model-list input[data-param='n']").first
     n.fill("200")
     n.dispatch_event("change")
     page.wait_for_function(f"document.querySelector('#spheres img').src !== {sphere0!r}",
                            timeout=120_000)
     wait_ready(page)
-    albedo1 = page.evaluate("document.getElementById('albedo').toDataURL()")
+    albedo1 = page.evaluate("drawnData('albedo')")
     assert albedo1 != albedo0  # the albedo curve moved with n
     # the state is in the URL: a new page at that URL restores n = 200
     shared = page.url

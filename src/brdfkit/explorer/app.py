@@ -2,8 +2,9 @@
 The explorer's web layer (FastAPI), thin over :mod:`brdfkit.explorer.views`
 ============================================================================
 
-One page (``static/index.html`` + ``static/app.js``, plain JavaScript drawing on
-canvases: no CDN, the page works offline) and a JSON API:
+One page (``static/index.html`` + ``static/app.js``, plain JavaScript drawing with
+Plotly.js — ``plotly.min.js`` served from the installed ``plotly`` package: no CDN, the
+page works offline) and a JSON API:
 
 ==========================  =================================================
 ``GET  /``                  the page
@@ -77,13 +78,30 @@ from brdfkit.explorer.worker import BUDGET_S, Fits, OverBudget, Worker
 from brdfkit.models import MODELS
 from brdfkit.spec import MAX_TIMES
 
-__all__ = ["create_app", "build_entry", "entry_spec", "parse_state"]
+__all__ = ["create_app", "build_entry", "entry_spec", "parse_state", "plotly_js"]
+
+#: The page's own files served under /static/ (and plotly.min.js, from the plotly package).
+_STATIC = ("app.js", "plots.js", "style.css")
+PLOTLY_JS = "plotly.min.js"
 
 #: Bytes of an oversized body read (and discarded) before answering 413: a client sending
 #: a little too much gets the message rather than a broken pipe; beyond this, the reply.
 _DRAIN_BYTES = 64 * guard.MAX_BODY_BYTES
 #: Models remembered as over the budget (a page shows 8; a few pages, a few edits).
 _COSTLY_SIZE = 64
+
+
+def plotly_js():
+    """The Plotly.js bundle the ``plotly`` wheel ships (``plotly/package_data``), as a
+    resource path; a BrdfkitError naming the package and its pip command when missing."""
+    try:
+        path = resources.files("plotly") / "package_data" / PLOTLY_JS
+    except ModuleNotFoundError:
+        path = None
+    if path is None or not path.is_file():
+        raise BrdfkitError("brdfkit explore draws its plots with Plotly.js from the 'plotly' "
+                           "package, which is not installed: pip install plotly")
+    return path
 
 
 def _number(state: dict, key: str, default: float, lo: float, hi: float) -> float:
@@ -286,7 +304,10 @@ def create_app(*, opened=(), allow_dirs=(), host: str = "127.0.0.1",
 
     @app.get("/static/{name}")
     def static_file(name: str):
-        if name not in ("app.js", "style.css"):
+        if name == PLOTLY_JS:  # 4.8 MB, the browser caches it (the page's files are not)
+            return Response(plotly_js().read_bytes(), media_type="text/javascript",
+                            headers={"Cache-Control": "max-age=86400"})
+        if name not in _STATIC:
             return JSONResponse({"error": f"no such file {name[:100]!r}"}, status_code=404)
         kind = "text/javascript" if name.endswith(".js") else "text/css"
         return Response((static / name).read_text(encoding="utf-8"), media_type=kind)

@@ -74,10 +74,11 @@ def serve(*, specs=(), models=None, host: str = LOCALHOST, port: int = DEFAULT_P
 
     import uvicorn
 
-    from brdfkit.explorer.app import create_app
+    from brdfkit.explorer.app import create_app, plotly_js
     from brdfkit.explorer.worker import BUDGET_S, SHUTDOWN_GRACE_S
     from brdfkit.spec import canonical_name
 
+    plotly_js()  # the page's plots: a missing plotly package is one line, before serving
     for d in allow_dirs:
         if not os.path.isdir(d):
             raise BrdfkitError(f"--allow-dir {d}: not a directory (give a directory whose "

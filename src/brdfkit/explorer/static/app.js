@@ -1,15 +1,13 @@
-// brdfkit explorer: plain JavaScript over the JSON API of brdfkit.explorer.app.
+// brdfkit explorer: plain JavaScript over the JSON API of brdfkit.explorer.app; the plots
+// are drawn by plots.js (Plotly.js).
 // The state lives in the URL hash (a shared link reopens the same view).
 // Models from files (.brdf, .py[:NAME], MERL .binary) carry their parameter declarations in
 // each /api/views answer; the page polls /api/changes and redraws when a shown file changes.
 "use strict";
 
-const COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf"];
-const CHANNEL_DASH = [[], [6, 3], [2, 2]];
 let catalog = null;
 let state = null;
 let lastViews = null;
-let lobeView = { yaw: -0.6, pitch: 0.5 };
 let pending = null;
 let inflight = false;
 // spec -> {file, digest, decl, reload_error, reloaded, compiled}: what the server said of a
@@ -21,6 +19,7 @@ const fileInfo = {};
 // needs no server thread and survives a server restart.
 const POLL_MS = 100;
 let since = null;  // the watch version the drawn views were built at
+let drawMs = null;  // the time the last drawAll took in the page (ms; the lobe: lobeMs)
 
 function defaultState() {
   return { models: [{ spec: "modified-phong", params: {}, pump: null, times: 1, visible: true }],
@@ -271,154 +270,7 @@ function bindGlobal(id, parse) {
   });
 }
 
-// ------------------------------------------------------------------ drawing helpers
-function axes(ctx, w, h, xr, yr, log, xlabel, ylabel) {
-  const m = { l: 48, r: 10, t: 10, b: 32 };
-  ctx.clearRect(0, 0, w, h);
-  ctx.fillStyle = "#fff"; ctx.fillRect(0, 0, w, h);
-  ctx.strokeStyle = "#999"; ctx.lineWidth = 1;
-  ctx.strokeRect(m.l, m.t, w - m.l - m.r, h - m.t - m.b);
-  const X = x => m.l + (x - xr[0]) / (xr[1] - xr[0]) * (w - m.l - m.r);
-  const ty = y => log ? Math.log10(Math.max(y, 1e-12)) : y;
-  const y0 = ty(yr[0]), y1 = ty(yr[1]);
-  const Y = y => h - m.b - (ty(y) - y0) / ((y1 - y0) || 1) * (h - m.t - m.b);
-  ctx.fillStyle = "#333"; ctx.font = "11px sans-serif";
-  ctx.fillText(xlabel, w / 2 - 40, h - 6);
-  ctx.save(); ctx.translate(12, h / 2 + 30); ctx.rotate(-Math.PI / 2); ctx.fillText(ylabel, 0, 0); ctx.restore();
-  for (let k = 0; k <= 4; k++) {
-    const x = xr[0] + k * (xr[1] - xr[0]) / 4;
-    ctx.fillText(x.toFixed(0), X(x) - 8, h - m.b + 12);
-    const yv = log ? Math.pow(10, y0 + k * (y1 - y0) / 4) : yr[0] + k * (yr[1] - yr[0]) / 4;
-    ctx.fillText(yv.toPrecision(2), 2, Y(yv) + 4);
-  }
-  return { X, Y };
-}
-
-function range(curves, log) {
-  let lo = Infinity, hi = -Infinity;
-  for (const c of curves) for (const v of c) {
-    if (log && !(v > 0)) continue;
-    lo = Math.min(lo, v); hi = Math.max(hi, v);
-  }
-  if (!isFinite(lo)) { lo = log ? 1e-3 : 0; hi = 1; }
-  if (log) lo = Math.max(lo, hi * 1e-5); else lo = Math.min(0, lo);
-  if (hi <= lo) hi = lo + 1;
-  return [lo, hi * (log ? 1.5 : 1.05)];
-}
-
-function polyline(ctx, xs, ys, T, colour, dash) {
-  ctx.strokeStyle = colour; ctx.lineWidth = 1.6; ctx.setLineDash(dash || []);
-  ctx.beginPath();
-  let started = false;
-  xs.forEach((x, k) => {
-    const y = ys[k];
-    if (!isFinite(y) || (state.log && !(y > 0))) { started = false; return; }
-    if (!started) { ctx.moveTo(T.X(x), T.Y(y)); started = true; } else ctx.lineTo(T.X(x), T.Y(y));
-  });
-  ctx.stroke(); ctx.setLineDash([]);
-}
-
-function drawPolar(items) {
-  const cv = document.getElementById("polar"), ctx = cv.getContext("2d");
-  const w = cv.width, h = cv.height;
-  ctx.fillStyle = "#fff"; ctx.fillRect(0, 0, w, h);
-  const cx = w / 2, cy = h - 24, R = Math.min(w / 2 - 10, h - 40);
-  const all = items.flatMap(([v]) => v.polar.values);
-  const [lo, hi] = range(all, state.log);
-  const rad = y => state.log ? Math.max(0, (Math.log10(Math.max(y, lo)) - Math.log10(lo)) / (Math.log10(hi) - Math.log10(lo))) : y / hi;
-  ctx.strokeStyle = "#ccc"; ctx.lineWidth = 1;
-  for (const f of [0.25, 0.5, 0.75, 1]) { ctx.beginPath(); ctx.arc(cx, cy, R * f, Math.PI, 2 * Math.PI); ctx.stroke(); }
-  ctx.beginPath(); ctx.moveTo(cx - R, cy); ctx.lineTo(cx + R, cy); ctx.stroke();
-  // the incident direction (on the left: negative θ_o side)
-  const ti = state.theta_i * Math.PI / 180;
-  ctx.strokeStyle = "#e69500"; ctx.beginPath(); ctx.moveTo(cx, cy);
-  ctx.lineTo(cx - R * Math.sin(ti), cy - R * Math.cos(ti)); ctx.stroke();
-  ctx.fillStyle = "#333"; ctx.font = "11px sans-serif";
-  ctx.fillText("max " + hi.toPrecision(3) + (state.log ? " (log radius)" : " (radius ∝ f)"), 6, 14);
-  for (const [v, i] of items) {
-    v.polar.values.forEach((ys, c) => {
-      ctx.strokeStyle = COLOURS[i % COLOURS.length]; ctx.lineWidth = 1.6;
-      ctx.setLineDash(CHANNEL_DASH[c % 3]); ctx.beginPath();
-      v.polar.theta_o_deg.forEach((t, k) => {
-        const r = R * Math.min(1, rad(ys[k])), a = t * Math.PI / 180;
-        const x = cx + r * Math.sin(a), y = cy - r * Math.cos(a);
-        if (k === 0) ctx.moveTo(x, y); else ctx.lineTo(x, y);
-      });
-      ctx.stroke(); ctx.setLineDash([]);
-    });
-  }
-}
-
-function drawLobe(items) {
-  const cv = document.getElementById("lobe"), ctx = cv.getContext("2d");
-  const w = cv.width, h = cv.height;
-  ctx.fillStyle = "#fff"; ctx.fillRect(0, 0, w, h);
-  const cy = Math.cos(lobeView.yaw), sy = Math.sin(lobeView.yaw);
-  const cp = Math.cos(lobeView.pitch), sp = Math.sin(lobeView.pitch);
-  const S = Math.min(w, h) * 0.42;
-  const P = (x, y, z) => {  // rotate about z (yaw) then tilt (pitch); z up on screen
-    const x1 = cy * x - sy * y, y1 = sy * x + cy * y;
-    const y2 = cp * y1 - sp * z, z2 = sp * y1 + cp * z;
-    return [w / 2 + S * x1, h * 0.78 - S * z2, y2];
-  };
-  ctx.strokeStyle = "#bbb"; ctx.beginPath();
-  for (let k = 0; k <= 48; k++) {
-    const a = 2 * Math.PI * k / 48, p = P(Math.cos(a), Math.sin(a), 0);
-    if (k === 0) ctx.moveTo(p[0], p[1]); else ctx.lineTo(p[0], p[1]);
-  }
-  ctx.stroke();
-  for (const [v, i] of items) {
-    const L = v.lobe;
-    ctx.strokeStyle = COLOURS[i % COLOURS.length]; ctx.lineWidth = 0.8;
-    const nt = L.x.length, np = L.x[0].length;
-    for (let a = 0; a < nt; a++) {
-      ctx.beginPath();
-      for (let b = 0; b < np; b++) {
-        const p = P(L.x[a][b], L.y[a][b], L.z[a][b]);
-        if (b === 0) ctx.moveTo(p[0], p[1]); else ctx.lineTo(p[0], p[1]);
-      }
-      ctx.stroke();
-    }
-    for (let b = 0; b < np; b += 2) {
-      ctx.beginPath();
-      for (let a = 0; a < nt; a++) {
-        const p = P(L.x[a][b], L.y[a][b], L.z[a][b]);
-        if (a === 0) ctx.moveTo(p[0], p[1]); else ctx.lineTo(p[0], p[1]);
-      }
-      ctx.stroke();
-    }
-    const wi = L.wi, o = P(0, 0, 0), q = P(wi[0], wi[1], wi[2]);
-    ctx.strokeStyle = "#e69500"; ctx.lineWidth = 2; ctx.beginPath();
-    ctx.moveTo(o[0], o[1]); ctx.lineTo(q[0], q[1]); ctx.stroke();
-  }
-}
-
-function drawCurves(items) {
-  const cv = document.getElementById("curves"), ctx = cv.getContext("2d");
-  const all = items.flatMap(([v]) => [...v.curves.theta_h, ...v.curves.theta_d, ...v.curves.theta_o.values]);
-  const T = axes(ctx, cv.width, cv.height, [-90, 90], range(all, state.log), state.log,
-                 "angle (deg): θh solid, θd dashed (right half); θo dotted (full)", "f (1/sr)");
-  for (const [v, i] of items) {
-    const col = COLOURS[i % COLOURS.length], x = v.curves.angle_deg;
-    v.curves.theta_h.forEach(ys => polyline(ctx, x, ys, T, col, []));
-    v.curves.theta_d.forEach(ys => polyline(ctx, x, ys, T, col, [6, 3]));
-    v.curves.theta_o.values.forEach(ys => polyline(ctx, v.curves.theta_o.theta_o_deg, ys, T, col, [2, 3]));
-  }
-}
-
-function drawAlbedo(items) {
-  const cv = document.getElementById("albedo"), ctx = cv.getContext("2d");
-  const all = items.flatMap(([v]) => v.albedo.values);
-  const hi = Math.max(1.05, ...all.flat().filter(isFinite));
-  const T = axes(ctx, cv.width, cv.height, [0, 90], [0, hi], false, "θi (deg)", "albedo a(θi)");
-  ctx.strokeStyle = "#aaa"; ctx.setLineDash([4, 4]); ctx.beginPath();
-  ctx.moveTo(T.X(0), T.Y(1)); ctx.lineTo(T.X(90), T.Y(1)); ctx.stroke(); ctx.setLineDash([]);
-  for (const [v, i] of items) {
-    v.albedo.values.forEach((ys, c) => polyline(ctx, v.albedo.theta_deg, ys, T,
-                                                COLOURS[i % COLOURS.length], CHANNEL_DASH[c % 3]));
-  }
-}
-
+// ------------------------------------------------------------------ drawing (plots.js)
 function drawImages(id, items, key) {
   const box = document.getElementById(id);
   box.innerHTML = "";
@@ -464,8 +316,12 @@ function drawAll() {
       v.reload_error : "";
     ok.push([v, i]);
   });
-  drawPolar(ok); drawLobe(ok); drawCurves(ok); drawAlbedo(ok);
-  drawImages("spheres", ok, "sphere"); drawImages("halfdiffs", ok, "halfdiff");
+  const t0 = performance.now();
+  const byId = id => document.getElementById(id);
+  drawPolar(byId("polar"), state, ok); scheduleLobe(byId("lobe"), state, ok);
+  drawCurves(byId("curves"), state, ok); drawAlbedo(byId("albedo"), state, ok);
+  drawImages("spheres", ok, "sphere"); drawHalfdiffs(byId("halfdiffs"), state, ok);
+  drawMs = performance.now() - t0;
   const errors = lastViews.models.filter(v => v.error || v.reload_error)
     .map(v => { const e = v.error || v.reload_error;  // a file's error already names it
                 return e.startsWith(v.file || v.spec) ? e : v.spec + ": " + e; });
@@ -540,7 +396,9 @@ async function update() {
       lastViews = { models: data.models, index: req.index, notes };
       drawAll();
       document.getElementById("timing").textContent =
-        "views " + data.ms + " ms on the server, " + Math.round(performance.now() - t0) + " ms round trip";
+        "views " + data.ms + " ms on the server, " + Math.round(performance.now() - t0) +
+        " ms round trip, drawn in " + Math.round(drawMs) + " ms" +
+        (lobeMs === null ? "" : " (+ 3-D lobe " + Math.round(lobeMs) + " ms)");
       document.getElementById("status").textContent = "ready";
       fetchVerdicts(req);
     } catch (e) {
@@ -682,10 +540,7 @@ async function init() {
     download(vis[0][0].spec.replace(/[^A-Za-z0-9._-]/g, "_") + ".binary", await res.blob());
   });
   for (const b of document.querySelectorAll("button.png")) {
-    b.addEventListener("click", () => {
-      const cv = document.getElementById(b.dataset.for);
-      cv.toBlob(blob => download("brdfkit-" + b.dataset.for + ".png", blob));
-    });
+    b.addEventListener("click", () => downloadPlot(b.dataset.for));
   }
   for (const b of document.querySelectorAll("button.png-img")) {  // every image of the view
     b.addEventListener("click", () => {
@@ -695,16 +550,7 @@ async function init() {
       });
     });
   }
-  const lobe = document.getElementById("lobe");
-  let drag = null;
-  lobe.addEventListener("mousedown", ev => { drag = [ev.clientX, ev.clientY, lobeView.yaw, lobeView.pitch]; });
-  window.addEventListener("mouseup", () => { drag = null; });
-  lobe.addEventListener("mousemove", ev => {
-    if (!drag) return;
-    lobeView.yaw = drag[2] + (ev.clientX - drag[0]) * 0.01;
-    lobeView.pitch = Math.max(-0.2, Math.min(1.5, drag[3] + (ev.clientY - drag[1]) * 0.01));
-    if (lastViews) drawLobe(lastViews.models.map((v, k) => [v, lastViews.index[k]]).filter(([v]) => !v.error));
-  });
+  liveWhileHovered(document.getElementById("lobe"));
   update();
   pollChanges();
 }
