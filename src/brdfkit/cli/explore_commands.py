@@ -10,7 +10,7 @@ from __future__ import annotations
 import click
 
 from brdfkit.explorer.serve import DEFAULT_PORT, LOCALHOST, serve
-from brdfkit.explorer.worker import BUDGET_S
+from brdfkit.explorer.worker import BUDGET_S, Worker
 
 __all__ = ["explore_cmd"]
 
@@ -48,5 +48,16 @@ def explore_cmd(specs, port, host, no_browser, allow_dirs, budget):
     only requests addressed to this server from its own page, computes each request
     for at most --budget seconds in a worker process; Ctrl-C stops it at once.
     """
-    serve(specs=specs, host=host, port=port, open_browser=not no_browser,
-          allow_dirs=allow_dirs, budget_s=budget, log=lambda s: click.echo(s, err=True))
+    # the worker process first: it imports and computes the page's first views while this
+    # process imports the web server and the page loads (an invalid spec or a port in use
+    # stops it again at once)
+    from brdfkit.explorer.compute import start_payload
+
+    worker = Worker(warm=start_payload(specs))
+    worker.start()
+    try:
+        serve(specs=specs, host=host, port=port, open_browser=not no_browser,
+              allow_dirs=allow_dirs, budget_s=budget, log=lambda s: click.echo(s, err=True),
+              worker=worker)
+    finally:
+        worker.stop()
