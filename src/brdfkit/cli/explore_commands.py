@@ -12,7 +12,7 @@ import click
 from brdfkit.cli._common import model_entry, model_word_options
 from brdfkit.errors import BrdfkitError
 from brdfkit.explorer.serve import DEFAULT_PORT, LOCALHOST, serve
-from brdfkit.explorer.worker import BUDGET_S
+from brdfkit.explorer.worker import BUDGET_S, Worker
 
 __all__ = ["explore_cmd"]
 
@@ -66,5 +66,16 @@ def explore_cmd(specs, param, compensate, pump, times, port, host, no_browser, a
         entries = None  # the short state #m=SPEC,... (the page's defaults)
     else:
         specs = [e["model"] for e in entries]
-    serve(specs=specs, models=entries, host=host, port=port, open_browser=not no_browser,
-          allow_dirs=allow_dirs, budget_s=budget, log=lambda s: click.echo(s, err=True))
+    # the worker process first: it imports and computes the page's first views while this
+    # process imports the web server and the page loads (an invalid spec or a port in use
+    # stops it again at once); models with words are computed when the page asks
+    from brdfkit.explorer.compute import start_payload
+
+    worker = Worker(warm=start_payload(specs if entries is None else ()))
+    worker.start()
+    try:
+        serve(specs=specs, models=entries, host=host, port=port, open_browser=not no_browser,
+              allow_dirs=allow_dirs, budget_s=budget, log=lambda s: click.echo(s, err=True),
+              worker=worker)
+    finally:
+        worker.stop()

@@ -73,7 +73,14 @@ from brdfkit.data import material_names
 from brdfkit.data.catalog import MATERIAL_SOURCES
 from brdfkit.errors import BrdfkitError
 from brdfkit.explorer import files, guard
-from brdfkit.explorer.compute import build_entry, entry_spec, error_entry
+from brdfkit.explorer.compute import (
+    JSONText,
+    build_entry,
+    entry_spec,
+    error_entry,
+    json_text,
+    start_payload,
+)
 from brdfkit.explorer.worker import BUDGET_S, Fits, OverBudget, Worker
 from brdfkit.models import MODELS
 from brdfkit.spec import MAX_TIMES
@@ -180,9 +187,21 @@ class _Guard:
         await self.app(scope, receive, send)
 
 
+def _views_response(out: list, version: int, t0: float) -> Response:
+    """The ``/api/views`` answer: the models' views are JSON text from the worker
+    (:class:`~brdfkit.explorer.compute.JSONText`), spliced in as they are (encoding them
+    again costs ~10 ms per model); error entries are encoded here."""
+    models = ",".join(m if isinstance(m, JSONText) else json_text(m) for m in out)
+    ms = round(1e3 * (time.perf_counter() - t0), 1)
+    return Response(f'{{"models":[{models}],"version":{int(version)},"ms":{ms!r}}}',
+                    media_type="application/json")
+
+
 def create_app(*, opened=(), allow_dirs=(), host: str = "127.0.0.1",
-               budget_s: float = BUDGET_S):
-    """The FastAPI application (one worker process per app, started on first use);
+               budget_s: float = BUDGET_S, worker: Worker | None = None):
+    """The FastAPI application (one worker process per app, started at once by the
+    lifespan, or *worker*, started by :func:`brdfkit.explorer.serve.serve` before the web
+    server's imports; it computes the page's first request while the page loads);
     *opened*: files the user named (the command line's specs; a Python file among them may
     run code); *allow_dirs*: directories whose data files any request may open
     (``--allow-dir``); *host*: the address served (the Host names accepted,
@@ -193,7 +212,9 @@ def create_app(*, opened=(), allow_dirs=(), host: str = "127.0.0.1",
     access = guard.FileAccess(given=[p for p in map(files.spec_file, opened) if p],
                               dirs=allow_dirs)
     watcher = files.FileWatcher()
-    worker = Worker(on_mark=watcher.mark)
+    if worker is None:
+        worker = Worker(warm=start_payload(opened))
+    worker.on_mark = watcher.mark
     # models that ran over the budget on a warm worker (LRU): the same model in the next
     # request (the page's verdict, a light move) is answered at once instead of stopping
     # the worker once more; another 'times' or parameter is another model
@@ -323,8 +344,7 @@ def create_app(*, opened=(), allow_dirs=(), host: str = "127.0.0.1",
         t0 = time.perf_counter()
         s = parse_state(await _body(request))
         out, version = await per_model("views", s)
-        return {"models": out, "version": version,
-                "ms": round(1e3 * (time.perf_counter() - t0), 1)}
+        return _views_response(out, version, t0)
 
     @app.post("/api/verdict")
     async def verdicts(request: Request):

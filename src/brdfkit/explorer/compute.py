@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import base64
 import json
+import math
 import tempfile
 from pathlib import Path
 
@@ -24,11 +25,47 @@ from brdfkit.errors import BrdfkitError
 from brdfkit.explorer import files, guard, views
 from brdfkit.spec import ModelSpec
 
-__all__ = ["Session", "entry_spec", "build_entry", "warm"]
+__all__ = ["Session", "entry_spec", "build_entry", "warm", "JSONText", "json_text",
+           "PAGE_STATE", "start_payload"]
 
 #: Models and view sets kept per session (LRU): a session flips between a few models; a
 #: pumped model holds its tables (up to a few MB)
 _CACHE_SIZE = 64
+
+#: The page's first state (``defaultState()`` in static/app.js, parsed as
+#: :func:`brdfkit.explorer.app.parse_state` parses it: angles in radians): the worker
+#: computes its views while the page loads (:func:`start_payload`).
+PAGE_STATE = {"theta_i": math.radians(30.0), "phi_i": 0.0, "phi_l": math.radians(30.0),
+              "ambient": 0.0, "mode": "luminance", "cosine": False}
+#: The page's first model when no spec is given (``defaultState()`` in static/app.js).
+PAGE_MODEL = "modified-phong"
+
+
+def start_payload(specs=()) -> dict:
+    """The "views" job of the page's first request: the *specs* given on the command line
+    (each at its defaults, as the page's ``#m=SPEC,...`` link sends them) or the page's
+    default model, at :data:`PAGE_STATE`. Files are left out (they load and compile
+    through :mod:`brdfkit.explorer.files` when the page asks)."""
+    named = [s for s in specs if isinstance(s, str) and files.spec_file(s) is None]
+    entries = [{"spec": s, "params": {}, "pump": None, "times": 1}
+               for s in (named or [PAGE_MODEL])]
+    return {"entries": entries[:guard.MAX_MODELS], "state": {**PAGE_STATE, "models": entries}}
+
+
+class JSONText(str):
+    """One model's views already encoded as JSON (the worker encodes them: a string crosses
+    the process boundary faster than nested lists, and the web server sends it as it is)."""
+
+
+def json_text(obj) -> str:
+    """*obj* as the web server sends JSON (compact, UTF-8, no NaN: a non-finite number or
+    a NumPy value goes through :func:`~brdfkit._io.to_jsonable`, NaN and ±inf → null).
+    The views are lists of Python floats already, so the fast path is the common one."""
+    try:
+        return json.dumps(obj, ensure_ascii=False, allow_nan=False, separators=(",", ":"))
+    except (TypeError, ValueError):
+        return json.dumps(to_jsonable(obj), ensure_ascii=False, allow_nan=False,
+                          separators=(",", ":"))
 
 
 def entry_spec(entry: dict) -> ModelSpec:
@@ -137,24 +174,34 @@ class Session:
                             + ("" if info.get("compiled", True) else "|interpreted")
                             + ("" if m.isotropic else f"|{phi!r}"), make)
 
-    def model_views(self, entry: dict, s: dict) -> dict:
-        """Every view of one entry for the state *s* (:func:`app.parse_state`), or
-        ``{"spec", "error"}``."""
+    def lit_sphere(self, entry: dict, m, info: dict, s: dict) -> tuple:
+        """The sphere view ``(PNG as a data URL, info)``: it depends on the model and the
+        light (Φ_L, ambient) alone, so a θ_i or φ_i move takes it from the cache."""
+        def make():
+            png, sph = views.sphere(m, phi_l=s["phi_l"], ambient=s["ambient"])
+            return _b64(png), sph
+        return self._cached(self._key(entry) + "|" + info.get("digest", "") + "|sphere|"
+                            + ("" if info.get("compiled", True) else "|interpreted")
+                            + f"|{float(s['phi_l'])!r}|{float(s['ambient'])!r}", make)
+
+    def model_views(self, entry: dict, s: dict) -> JSONText | dict:
+        """Every view of one entry for the state *s* (:func:`app.parse_state`) as JSON
+        text, or ``{"spec", "error"}``."""
         try:
             m, info = self.get_built(entry)
-            png_s, sph = views.sphere(m, phi_l=s["phi_l"], ambient=s["ambient"])
-            return to_jsonable({
-                **info,
-                "spec": entry.get("spec"), "name": m.name, "params": m.to_dict()["params"],
+            png_s, sph = self.lit_sphere(entry, m, info, s)
+            return JSONText(json_text({
+                **to_jsonable({**info, "spec": entry.get("spec"), "name": m.name,
+                               "params": m.to_dict()["params"]}),
                 "polar": views.polar(m, s["theta_i"], s["phi_i"], cosine=s["cosine"],
                                      mode=s["mode"]),
                 "lobe": views.lobe(m, s["theta_i"], s["phi_i"]),
                 "curves": views.curves(m, s["theta_i"], s["phi_i"], cosine=s["cosine"],
                                        mode=s["mode"]),
-                "sphere": _b64(png_s), "sphere_info": sph,
+                "sphere": png_s, "sphere_info": sph,
                 "reciprocal_claim": m.reciprocal,
                 **self.model_only(entry, m, info, s["mode"], s["phi_i"]),
-            })
+            }))
         except BrdfkitError as exc:
             return error_entry(entry, str(exc))
 

@@ -66,10 +66,11 @@ def _check_free(host: str, port: int) -> None:
 
 def serve(*, specs=(), models=None, host: str = LOCALHOST, port: int = DEFAULT_PORT,
           open_browser: bool = True, allow_dirs=(), budget_s: float | None = None,
-          log=print) -> None:
+          log=print, worker=None) -> None:
     """Serve until Ctrl-C. *specs* (model names or material specs) are validated first;
     *allow_dirs* must be directories. *models* (ModelSpec dict forms of *specs*, with their
-    parameters and operators) open them so (:func:`start_url`)."""
+    parameters and operators) open them so (:func:`start_url`). *worker*: the app's worker,
+    started already (:func:`brdfkit.explorer.app.create_app`; the caller stops it)."""
     import os
 
     import uvicorn
@@ -94,7 +95,7 @@ def serve(*, specs=(), models=None, host: str = LOCALHOST, port: int = DEFAULT_P
              f"every machine that can reach {host} (--host given)")
     log(f"brdfkit explore: serving on {url} ({where}); Ctrl-C stops")
     app = create_app(opened=specs, allow_dirs=allow_dirs, host=host,
-                     budget_s=BUDGET_S if budget_s is None else budget_s)
+                     budget_s=BUDGET_S if budget_s is None else budget_s, worker=worker)
     # the shutdown waits SHUTDOWN_GRACE_S for running requests, then cancels them (their
     # worker is killed): Ctrl-C stops the server at once even mid-computation
     config = uvicorn.Config(app, host=host, port=port, log_level="warning",

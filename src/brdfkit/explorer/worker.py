@@ -41,7 +41,7 @@ __all__ = ["Worker", "Fits", "OverBudget", "BUDGET_S", "MAX_WAITING", "FIT_BUDGE
 
 #: Seconds one request may compute by default (``brdfkit explore --budget``): a slider move
 #: takes 0.03-0.1 s, a new pumped model 2-13 s (times 1-3, measured), a new MERL material's
-#: verdict ~6 s, the worker's cold start ~5 s; a pumped model with times 8 takes over 12 min.
+#: verdict ~6 s, the worker's cold start ~2-5 s; a pumped model with times 8 takes over 12 min.
 BUDGET_S = 30.0
 #: Requests waiting for the worker at once; more are answered "busy" (the page sends one
 #: views and one verdict request at a time; several pages or a script may send more).
@@ -118,7 +118,11 @@ def _worker_main(conn) -> None:
             conn.send(msg)
 
     session = Session(mark=lambda path: send(("mark", path)))
-    _warm_up()
+    try:  # the first message: the page's first request, computed while the page loads
+        first = conn.recv()
+    except (EOFError, OSError):
+        os._exit(0)
+    _warm_up(session, first[1] if first and first[0] == "warm" else None)
     send(("ready",))
     while True:
         try:
@@ -134,15 +138,17 @@ def _worker_main(conn) -> None:
             send(("error", job_id, _internal(exc), 500))
 
 
-def _warm_up() -> None:
-    """Load what every request needs (the views' kernels from Numba's disk cache, the
-    renderer, the albedo engine) before the first job: ~3-5 s, while the page loads."""
-    import brdfkit
-    from brdfkit.explorer.compute import warm
-
+def _warm_up(session, payload: dict | None) -> None:
+    """Compute the page's first request (*payload*, a "views" job:
+    :func:`~brdfkit.explorer.compute.start_payload`) before the first job: the imports, the
+    views' kernels from Numba's disk cache, the sphere's loop compiled for that model, and
+    the model's albedo curve and θ_h × θ_d image kept in the session's cache, so that the
+    page's first ``/api/views`` finds them ready. An error is the first job's to show."""
+    if payload is None:
+        return
     try:
-        warm(brdfkit.model("lambert"))
-    except BrdfkitError:  # never: a built-in model; the first job would show the error
+        _run(session, "views", payload, lambda i, v: None)
+    except (Exception, RecursionError):  # noqa: BLE001 - the page's request reports it
         pass
 
 
@@ -187,10 +193,13 @@ class _Job:
 
 class Worker:
     """The web server's handle on its worker process (module docstring). *on_mark(path)*:
-    a file's compiled model is ready. Started on first use; :meth:`stop` ends it."""
+    a file's compiled model is ready; *warm*: the "views" job a new process computes before
+    any other (the page's first request, :func:`~brdfkit.explorer.compute.start_payload`;
+    None: nothing). Started by :meth:`start` or on first use; :meth:`stop` ends it."""
 
-    def __init__(self, *, on_mark=None):
-        self._on_mark = on_mark
+    def __init__(self, *, on_mark=None, warm: dict | None = None):
+        self.on_mark = on_mark
+        self.warm = warm  # the "views" job a new process computes first (_warm_up)
         self._lock = threading.Lock()  # the process handle
         self._slot = threading.Lock()  # one job at a time
         self._waiting = 0
@@ -214,6 +223,10 @@ class Worker:
                 return
             self._proc, parent = _start_child("worker")
             self._conn = parent
+            try:
+                parent.send(("warm", self.warm))
+            except OSError:  # the process died at once: the first job reports it
+                pass
             threading.Thread(target=self._read, args=(parent,), daemon=True,
                              name="brdfkit worker reader").start()
 
@@ -224,8 +237,8 @@ class Worker:
             except (EOFError, OSError):
                 break
             if msg[0] == "mark":
-                if self._on_mark is not None:
-                    self._on_mark(msg[1])
+                if self.on_mark is not None:
+                    self.on_mark(msg[1])
                 continue
             if msg[0] == "ready":
                 self._ready = conn
