@@ -161,7 +161,7 @@ def test_mitsuba_seed_range_in_the_api():
 @pytest.mark.parametrize(("args", "fragments"), [
     (["--seed", "99999999999999999999"], ["seed", "4294967295"]),
     # 2048 x 1536 px x 4096 spp = 1.3e10 samples per render (> 5 GB and days before)
-    (["--spp", "4096", "--size", "2048"], ["2^30", "341"]),
+    (["--spp", "4096", "--panel-size", "2048"], ["2^30", "341"]),
 ])
 def test_figure_fig8_limits_are_one_line_errors(tmp_path, args, fragments):
     out = tmp_path / "f.png"

@@ -57,17 +57,7 @@ import numba
 import numpy as np
 
 from brdfkit._cache import memo
-from brdfkit._dual import (  # phong-energy-conserving's formulas (its section below)
-    Formulas,
-    cos,
-    formula,
-    maximum,
-    minimum,
-    power,
-    select,
-    sin,
-    sqrt,
-)
+from brdfkit._dual import Formulas, cos, formula, maximum, minimum, power, select, sin, sqrt
 from brdfkit._kern import INV_PI, INV_TWO_PI, below_horizon, n_dot_h, r_dot_v
 from brdfkit.halfangle import beta_from_exponent
 from brdfkit.models._base import VECTOR_OPTIONS, Lobe, Param
