@@ -495,3 +495,11 @@ def test_as_directions_keeps_numeric_behaviour():
 def test_as_uniform_rejects_strings():
     with pytest.raises(BrdfkitError, match="^u "):
         as_uniform("0.5,0.5")
+
+
+def test_unknown_figure_is_told_before_a_missing_out():
+    # a misspelt name is the fault to fix first: asking for --out would send the user to
+    # a second error after adding it
+    assert_one_line_error(run("figure", "lewis-fig55"), "unknown figure 'lewis-fig55'",
+                          "lewis-fig5")
+    assert_one_line_error(run("figure", "lewis-fig5"), "needs --out")

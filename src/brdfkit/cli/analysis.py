@@ -391,15 +391,15 @@ def figure_cmd(name, model, out, dpi, model_old, param, compensate, pump, times,
                                f"drop --out {out}")
         click.echo("\n".join(figure_names()))
         return
+    key = resolve_figure(name)  # an unknown name is told before a missing --out
     if out is None:
-        raise BrdfkitError(f"figure {name} needs --out FILE (.png or .svg), e.g. "
-                           f"brdfkit figure {name} --out {name}.png")
+        raise BrdfkitError(f"figure {key} needs --out FILE (.png or .svg), e.g. "
+                           f"brdfkit figure {key} --out {key}.png")
     if model is not None and model_old is not None:
         raise BrdfkitError(f"give the model once: {model} (the argument) or --model "
                            f"{model_old}, not both")
     model = model if model is not None else model_old
     size = panel_size if panel_size is not None else size_old
-    key = resolve_figure(name)  # name and path are checked before the "building" line
     check_output_path(out, option="--out")
     if model is None and (param or compensate or pump or times is not None or compare):
         raise BrdfkitError("-p, --compensate, --pump, --times and --compare describe MODEL; "
