@@ -29,6 +29,8 @@ parameter values are arguments, not literals (a new value compiles nothing).
 Public objects
 --------------
 - :func:`lafortune_formulas`, :func:`nh_series_formulas` — a model's ``Formulas``.
+- :func:`mixture_pick_lines` — ``Mixture.sample``'s pick as generated formula lines
+  (also the Kulla–Conty sampler's, :mod:`brdfkit.compensation.kernels`).
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ from brdfkit._cache import memo
 from brdfkit._dual import Formulas
 from brdfkit.models._lobes import lobe_mode
 
-__all__ = ["lafortune_formulas", "nh_series_formulas"]
+__all__ = ["lafortune_formulas", "nh_series_formulas", "mixture_pick_lines"]
 
 _HEADER = '''"""brdfkit: generated {what} formulas, {m} lobes (models/lobe_series)."""
 from brdfkit._dual import exp, formula, log, maximum, minimum, power, select, sqrt
@@ -62,9 +64,10 @@ def _chain(names: list[str], k: str = "k") -> str:
     return out
 
 
-def _pick(weights: list[str]) -> list[str]:
+def mixture_pick_lines(weights: list[str]) -> list[str]:
     """Lines setting k (the picked component, a float) and ur (u₀ rescaled into it) from
-    the normalised weights *weights*: ``Mixture.sample``'s pick, unrolled."""
+    the normalised weights *weights* (names or expressions of the generated formula, which
+    imports ``select``, ``minimum``, ``maximum``): ``Mixture.sample``'s pick, unrolled."""
     n = len(weights)
     lines = [f"    c0 = {weights[0]}"]
     lines += [f"    c{j} = c{j - 1} + {weights[j]}" for j in range(1, n)]
@@ -133,7 +136,7 @@ def _lafortune_source(m: int, modes: tuple, cache: bool) -> str:
     s += [f"\n\n@formula(cache={cache})",
           f"def lafortune_sample(ox, oy, oz, u0, u1, log_d, log_s, {args}):",
           f"    {unpack} = {call}"]
-    s += _pick([f"w{j}" for j in range(m + 1)])
+    s += mixture_pick_lines([f"w{j}" for j in range(m + 1)])
     # component k ≥ 1 is lobe k − 1; component 0 (and an exponent 0) the cosine
     ax = _chain(["0.0"] + [f"a{j}x" for j in range(m)])
     ay = _chain(["0.0"] + [f"a{j}y" for j in range(m)])
@@ -173,7 +176,7 @@ def _nh_source(m: int, modes: tuple, cache: bool) -> str:
     s += ["    return select((iz > 0.0) & (oz > 0.0), acc, 0.0)",
           f"\n\n@formula(cache={cache})",
           f"def nh_series_sample(ox, oy, oz, u0, u1, {ws}, {ns}):"]
-    s += _pick([f"w{j}" for j in range(m)])
+    s += mixture_pick_lines([f"w{j}" for j in range(m)])
     s += ["    cx, cy, cz = malley(ur, u1)",
           f"    nk = {_chain([f'n{j}' for j in range(m)])}",
           # h about the normal, ω_i its mirror (HalfVector(PowerHalf(n)))
