@@ -180,16 +180,20 @@ def test_pumped_traced_matches_numba_and_samples_the_root(root, g, times):
 @pytest.mark.parametrize("kw", [
     {"distribution": "ggx", "alpha": 0.5, "eta": [0.2, 0.9, 1.1], "k": [3.9, 2.4, 2.2]},
     {"alpha": 0.3}], ids=["ggx-conductor-rgb", "beckmann-white"])
-def test_turquin_traced_matches_numba_and_kulla_conty_says_why(kw):
-    """Turquin's compensation (Ẽ read with lookup_w in the trace) against model.eval, the
-    base's sampler; Kulla–Conty (a sampler weighted by Ẽ(ω_o)) falls back with a reason."""
+@pytest.mark.parametrize("method", ["turquin", "kulla-conty"])
+def test_compensated_traced_matches_numba(kw, method):
+    """Turquin's and Kulla–Conty's compensation (Ẽ read with lookup/lookup_w in the trace)
+    against model.eval (the Numba kernel composed separately); the sampler: Turquin's the
+    base's, Kulla–Conty's the mixture of the cosine and the base's sampler (its weight's Ẽ
+    a polynomial, in NumPy and in the trace): traced pdf and directions = model.pdf and
+    model.sample for the same u. (Kulla–Conty fell back to the wavefront route before.)"""
     variant = _variant("llvm_ad_rgb")
     if not variant.startswith("llvm"):
         pytest.skip("no LLVM")
     base = brdfkit.model("microfacet", **kw)
-    model = brdfkit.compensate(base, "turquin")
+    model = brdfkit.compensate(base, method)
     ours = mitsuba_bsdf(model)
-    assert ours.traced
+    assert ours.traced and ours.route_reason is None
     rng = np.random.default_rng(8)
     n = 512
     view, light = _hemisphere(rng, n), _hemisphere(rng, n)
@@ -201,13 +205,31 @@ def test_turquin_traced_matches_numba_and_kulla_conty_says_why(kw):
                                atol=1e-6 * want.max())
     plain = np.asarray(base.eval(light, view)).reshape(n, -1) * light[:, 2:3]
     assert np.abs(got - plain).max() > 1e-2 * plain.max()  # power: the factor is in it
-    np.testing.assert_allclose(np.array(ours.pdf(ctx, si, wo)), base.pdf(light, view),
+    np.testing.assert_allclose(np.array(ours.pdf(ctx, si, wo)), model.pdf(light, view),
                                rtol=1e-4, atol=1e-7)
+    u = rng.random((n, 2)).astype(np.float32)
+    bs, _ = ours.sample(ctx, si, 0.5, mi.Point2f(u.T))
+    want_wi, _ = model.sample(view, u.astype(float))
+    np.testing.assert_allclose(np.array(bs.wo).T, want_wi, atol=2e-5)
+    if method == "kulla-conty":  # power: the cosine component is sampled too
+        assert np.abs(model.pdf(light, view) - base.pdf(light, view)).max() > 1e-3
     del ours
-    with pytest.warns(WavefrontRouteWarning, match="no formulas"):
-        kc = mitsuba_bsdf(brdfkit.compensate(base, "kulla-conty"))
-    assert not kc.traced
-    del kc
+    gc.collect()
+
+
+def test_kulla_conty_traced_sampler_chi2():
+    """Mitsuba's χ² harness on the traced Kulla–Conty sampler (cosine + GGX, weighted per
+    ω_o) against its traced pdf."""
+    _variant("llvm_ad_rgb")
+    from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
+
+    props = {"type": "brdfkit", "model": "microfacet", "distribution": "ggx", "alpha": 0.6,
+             "compensate": "kulla-conty"}
+    sample_func, pdf_func = BSDFAdapter("brdfkit", props, wi=[0.6, 0.0, 0.8])
+    chi2 = ChiSquareTest(domain=SphericalDomain(), sample_func=sample_func,
+                         pdf_func=pdf_func, sample_dim=3, res=51, ires=4,
+                         sample_count=200_000)
+    assert chi2.run(), chi2.messages
     gc.collect()
 
 

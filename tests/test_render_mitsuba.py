@@ -314,6 +314,7 @@ def test_white_furnace(pumped):
     model = brdfkit.model("modified-phong", rho_d=0.2, rho_s=0.5, n=20.0)
     if pumped == "kulla-conty":
         model = brdfkit.compensate(model, "kulla-conty")
+        assert mitsuba_bsdf(model).traced  # its formulas (the wavefront route before)
     elif pumped:
         model = pump(model, g="max")
     imgs = renders(model, variant=variant, size=size, spp=spp, k=k, irradiance=0.0,
