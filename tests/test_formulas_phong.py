@@ -257,5 +257,4 @@ def test_chi2_traced_lobe_series_sampler(name, params, wi):
                          pdf_func=pdf_func, sample_dim=3, res=51, ires=4,
                          sample_count=200_000)
     assert chi2.run(), chi2.messages
-    del bsdf
     gc.collect()

@@ -244,7 +244,7 @@ def series_terms(g_max: float) -> int:
     return SERIES_MAX_TERMS + 1
 
 
-_EVAL_SOURCE = '''"""brdfkit: generated he-torrance formula, {n} terms of D's series (he_torrance)."""
+_EVAL_SOURCE = '''"""brdfkit: generated he-torrance formula, {n} terms of D's series."""
 from brdfkit._dual import exp, formula, select, sqrt
 from brdfkit.fresnel import _fresnel_conductor
 from brdfkit.models.he_torrance import (INV_PI, QUARTER_PI2, TWO_PI, htsg_shadow_formula,
@@ -277,8 +277,8 @@ def he_torrance_eval(ix, iy, iz, ox, oy, oz, p):
 
 
 def _eval_source(n: int, cache: bool) -> str:
-    terms = "\n".join(f"    w = w * g / {float(m)!r}\n    t = t + w / {float(m)!r} * exp(-a / {float(m)!r})"
-                      for m in range(2, n + 1))
+    terms = "\n".join(f"    w = w * g / {m!r}\n    t = t + w / {m!r} * exp(-a / {m!r})"
+                      for m in (float(k) for k in range(2, n + 1)))
     return _EVAL_SOURCE.format(n=n, cache=cache, terms=terms, p_sigma0=P_SIGMA0, p_tau=P_TAU,
                                p_eta=P_ETA, p_k=P_K, p_rho_d=P_RHO_D)
 

@@ -83,7 +83,8 @@ def mixture_pick_lines(weights: list[str]) -> list[str]:
     lines.append(f"    wk = {_chain(weights)}")
     lines.append(f"    ck = {_chain([f'c{j}' for j in range(n)])}")
     # clipped to [0, 1] against rounding, as Mixture.sample
-    lines.append("    ur = minimum(maximum((u0 - (ck - wk)) / select(wk > 0.0, wk, 1.0), 0.0), 1.0)")
+    lines.append("    ur = minimum(maximum((u0 - (ck - wk)) / select(wk > 0.0, wk, 1.0), 0.0),"
+                 " 1.0)")
     return lines
 
 
@@ -91,7 +92,8 @@ def mixture_pick_lines(weights: list[str]) -> list[str]:
 def _lafortune_source(m: int, modes: tuple, cache: bool) -> str:
     lobes = [f"x{j}, z{j}, n{j}" for j in range(m)]
     args = ", ".join(lobes)
-    s = [_HEADER.format(what="lafortune", m=m, inv_pi=1.0 / math.pi, pi=math.pi, two_pi=2.0 * math.pi,
+    s = [_HEADER.format(what="lafortune", m=m, inv_pi=1.0 / math.pi, pi=math.pi,
+                        two_pi=2.0 * math.pi,
                         log_pi=math.log(math.pi)),
          f"\n\n@formula(cache={cache})",
          "def lafortune_eval(ix, iy, iz, ox, oy, oz, p):",
@@ -104,7 +106,7 @@ def _lafortune_source(m: int, modes: tuple, cache: bool) -> str:
                  f"p[{3 + 2 * m + j}], {modes[j]})")
     s.append("    return select((iz > 0.0) & (oz > 0.0), p[0] * INV_PI + p[1] * acc, 0.0)")
     # the weights' logarithms and the lobes' unit axes at wo
-    s += ["\n\n@formula(cache={cache})".format(cache=cache),
+    s += [f"\n\n@formula(cache={cache})",
           f"def lafortune_weights(ox, oy, oz, log_d, log_s, {args}):",
           "    r2 = ox * ox + oy * oy"]
     for j in range(m):

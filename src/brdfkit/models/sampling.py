@@ -80,7 +80,8 @@ __all__ = [
     "HalfVectorDistribution", "PowerHalf", "Mixture",
     "StrategySampled", "phong_lobe", "blinn_lobe", "sample_phong_lobe", "pdf_phong_lobe",
     "sample_blinn_lobe", "pdf_blinn_lobe", "diffuse_fraction", "split_uniform",
-    "normalised_weights", "log_mixture_weights", "malley", "half_pdf_terms", "cos_power_normal_sample",
+    "normalised_weights", "log_mixture_weights", "malley", "half_pdf_terms",
+    "cos_power_normal_sample",
     "cos_power_normal_pdf",
 ]
 
