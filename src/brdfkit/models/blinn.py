@@ -46,6 +46,7 @@ from brdfkit.models._lobes import (
     RHO_D,
     RHO_S,
     CosineLobeBRDF,
+    DiffuseLobeBRDF,
     KdKsBlinnBRDF,
     lobe_hint,
     lobe_pow,
@@ -237,7 +238,7 @@ def _modified_blinn_phong_int(ix, iy, iz, ox, oy, oz, p):
 
 
 @register
-class ModifiedBlinnPhong(CosineLobeBRDF):
+class ModifiedBlinnPhong(DiffuseLobeBRDF):
     """Modified Blinn–Phong: Nielsen et al. eq. (2), after Akenine-Möller et al. 2008.
 
     f_r = ρ_d/π + ρ_s (n+8)/(8π) (ω_h·n)ⁿ. The factor (n+8)/8π is an
@@ -282,9 +283,7 @@ class ModifiedBlinnPhong(CosineLobeBRDF):
         {"rho_d": [0.1, 0.2, 0.3], "rho_s": [0.5, 0.4, 0.3], "n": 2.0},
     )
 
-    def lobes(self):
-        out = [Lobe("diffuse", math.pi / 2)] if np.any(self._values["rho_d"]) else []
-        return out + [lobe_hint("half", self._values["n"])]
+    diffuse_param = "rho_d"
 
     def _strategy(self, wo):
         v = self._values
