@@ -28,6 +28,18 @@ lobe, :func:`brdfkit.user.proxy_sampler.proxy_args`) — the closest native BSDF
 images of a material are compared between its two routes (different samplers of one
 f_r: within Monte-Carlo noise);
 
+in ``llvm_ad_rgb`` again, the last four model kinds ported to the traced route (issue 23,
+``--sections ported``): ``lafortune`` (one lobe, and the two-lobe example) and
+``nh-power-series`` (three terms) against Mitsuba's ``roughplastic`` (GGX of the lobe's
+proxy α, the same diffuse ρ) — a diffuse + glossy pair, the closest native BSDF — and
+against the traced ``modified-phong`` (a cosⁿ lobe, their Dr.Jit twin of one lobe);
+``he-torrance`` (σ₀ = 0.1: 16 terms of D's series; σ₀ = 0.3: 54) against
+``roughconductor`` (Beckmann, α = its sampler's m); the GGX conductor compensated by
+Kulla–Conty against ``roughconductor`` of the same α, η, k (the ratio is the cost of the
+compensation); and the wavefront route of lafortune, he-torrance and the compensated
+conductor for comparison. The extra column ``vs twin`` is the row's median over the
+named twin's;
+
 and in ``llvm_ad_spectral`` a gold-like metal with n(λ), k(λ) on a 16-point grid over
 360-830 nm: Mitsuba's ``roughconductor`` with the grid as ``irregular`` spectra against
 the bridge's traced ``spectral_model("microfacet", …)`` (parameters interpolated at each
@@ -48,6 +60,7 @@ Usage::
 
     .venv/bin/python benchmarks/bench_render_mitsuba.py            # 256², 16 spp, 5 repeats
     .venv/bin/python benchmarks/bench_render_mitsuba.py --size 128 --spp 8 --repeats 3
+    .venv/bin/python benchmarks/bench_render_mitsuba.py --sections ported --size 128
 """
 
 from __future__ import annotations
@@ -114,13 +127,18 @@ def time_rows(mi, rows, variant, args) -> dict:
     return results
 
 
-def report(results, rows, variant, args, pairs, same) -> None:
+def report(results, rows, variant, args, pairs, same, twins=None) -> None:
+    """The table (ratio: over the first row; ``vs twin``: over the row *twins* names)."""
     base = results[rows[0][0]][0]
+    twins = twins or {}
     print(f"\n{variant}: {args.size}² pixels, {args.spp} spp, {args.repeats} repeats")
-    print(f"{'renderer':44s} {'median s':>9s} {'ratio':>7s}")
+    print(f"{'renderer':44s} {'median s':>9s} {'ratio':>7s}"
+          + (f" {'vs twin':>8s}  twin" if twins else ""))
     for name, _, _ in rows:
         t = results[name][0]
-        print(f"{name:44s} {t:9.3f} {t / base:7.2f}")
+        twin = twins.get(name)
+        extra = f" {t / results[twin][0]:8.2f}  {twin}" if twin else ""
+        print(f"{name:44s} {t:9.3f} {t / base:7.2f}{extra}")
     for a, b in pairs:  # agreement: the image sums within 3 standard errors
         ia, ib = results[a][1], results[b][1]
         d = ia.mean(axis=0) - ib.mean(axis=0)
@@ -138,8 +156,8 @@ def main() -> None:
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--spp", type=int, default=16)
     ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--sections", default="rgb,measured,spectral",
-                    help="comma-separated subset of rgb, measured, spectral")
+    ap.add_argument("--sections", default="rgb,measured,ported,spectral",
+                    help="comma-separated subset of rgb, measured, ported, spectral")
     args = ap.parse_args()
     sections = set(args.sections.split(","))
 
@@ -150,6 +168,8 @@ def main() -> None:
         rgb_rows(mi, args)
     if "measured" in sections:
         measured_rows(mi, args)
+    if "ported" in sections:
+        ported_rows(mi, args)
     if "spectral" in sections:
         spectral_rows(mi, args)
     print(f"\nload average after: {os.getloadavg()[0]:.2f}")
@@ -213,6 +233,65 @@ def measured_rows(mi, args) -> None:
     results = time_rows(mi, rows, variant, args)
     report(results, rows, variant, args,
            pairs=[(rows[1][0], rows[2][0]), (rows[7][0], rows[8][0])], same=[])
+
+
+def ported_rows(mi, args) -> None:
+    import warnings
+
+    from brdfkit.user.proxy_sampler import proxy_args
+
+    variant = use_variant("llvm_ad_rgb")
+    laf = brdfkit.model("lafortune", rho_d=0.2, rho_s=1.0, n=20.0)
+    laf2 = brdfkit.model("lafortune", C_xy=[-1.0, -0.9], C_z=[1.0, 0.7], n=[20.0, 5.0])
+    nhs = brdfkit.model("nh-power-series", k_s=[0.06, 0.5, 5.0], n=[0.0, 10.0, 200.0])
+    phong = brdfkit.model("modified-phong", rho_d=0.2, rho_s=0.5, n=20.0)
+    ht = brdfkit.model("he-torrance", sigma0=0.1, tau=1.7, rho_d=0.1)
+    ht3 = brdfkit.model("he-torrance", sigma0=0.3, tau=3.0, rho_d=0.1)
+    kc = brdfkit.compensate(brdfkit.model("microfacet", distribution="ggx", alpha=0.5,
+                                          eta=ETA, k=K), "kulla-conty")
+    a_laf = proxy_args(laf)[0]
+    plastic = {"type": "roughplastic", "distribution": "ggx", "alpha": a_laf,
+               "diffuse_reflectance": {"type": "rgb", "value": [0.2, 0.2, 0.2]}}
+    conductor = {"type": "roughconductor", "distribution": "ggx", "alpha": 0.5,
+                 "eta": {"type": "rgb", "value": ETA}, "k": {"type": "rgb", "value": K}}
+
+    def beckmann(m):
+        return {"type": "roughconductor", "distribution": "beckmann", "alpha": m}
+
+    def bsdf(model, **kw):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # he-torrance: its delta is not rendered
+            return mitsuba_bsdf(model, **kw)
+
+    rows = [
+        (f"roughplastic α={a_laf:.3f} (Mitsuba, symbolic)", lambda: plastic, False),
+        ("bridge modified-phong n=20 (traced)", lambda: bsdf(phong), False),
+        ("bridge lafortune 1 lobe (traced)", lambda: bsdf(laf), False),
+        ("bridge lafortune 2 lobes (traced)", lambda: bsdf(laf2), False),
+        ("bridge lafortune 1 lobe (wavefront route)",
+         lambda: bsdf(laf, route="wavefront"), True),
+        ("bridge nh-power-series 3 terms (traced)", lambda: bsdf(nhs), False),
+        (f"roughconductor beckmann α={ht._sampling_m():.3f} (Mitsuba)",
+         lambda: beckmann(ht._sampling_m()), False),
+        ("bridge he-torrance σ0=0.1, 16 terms (traced)", lambda: bsdf(ht), False),
+        ("bridge he-torrance σ0=0.1 (wavefront route)",
+         lambda: bsdf(ht, route="wavefront"), True),
+        (f"roughconductor beckmann α={ht3._sampling_m():.3f} (Mitsuba)",
+         lambda: beckmann(ht3._sampling_m()), False),
+        ("bridge he-torrance σ0=0.3, 54 terms (traced)", lambda: bsdf(ht3), False),
+        ("roughconductor GGX α=0.5 (Mitsuba, symbolic)", lambda: conductor, False),
+        ("bridge microfacet+kulla-conty (traced)", lambda: bsdf(kc), False),
+        ("bridge microfacet+kulla-conty (wavefront)", lambda: bsdf(kc, route="wavefront"),
+         True),
+    ]
+    n = [r[0] for r in rows]
+    twins = {n[1]: n[0], n[2]: n[0], n[3]: n[0], n[4]: n[0], n[5]: n[0], n[7]: n[6],
+             n[8]: n[6], n[10]: n[9], n[12]: n[11], n[13]: n[11]}
+    results = time_rows(mi, rows, variant, args)
+    report(results, rows, variant, args,
+           pairs=[(n[2], n[4]), (n[7], n[8]), (n[12], n[13])], same=[], twins=twins)
+    for a in (n[2], n[3], n[5]):
+        print(f"{a} vs {n[1]}: {results[a][0] / results[n[1]][0]:.2f}")
 
 
 def spectral_rows(mi, args) -> None:

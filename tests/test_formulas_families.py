@@ -237,18 +237,3 @@ def test_chi2_traced_sampler(props, wi):
                          sample_count=200_000)
     assert chi2.run(), chi2.messages
     gc.collect()
-
-
-@pytest.mark.parametrize("name", ["lafortune", "he-torrance"])
-def test_models_left_on_the_wavefront_route_say_why(name):
-    """lafortune and he-torrance give no formulas (loops: see their ``wavefront_reason``):
-    the bridge takes the wavefront route, and the reason is one line."""
-    _variant("llvm_ad_rgb")
-    model = brdfkit.model(name)
-    assert model.formulas() is None
-    reason = type(model).wavefront_reason
-    assert isinstance(reason, str) and reason and "\n" not in reason
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # he-torrance: its delta is not rendered
-        assert not mitsuba_bsdf(model).traced
-    gc.collect()

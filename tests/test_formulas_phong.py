@@ -1,12 +1,15 @@
 """The Phong family as formulas (:mod:`brdfkit._dual`): eval, sampler and pdf.
 
 ``modified-phong``, ``phong``, ``blinn``, ``phong-blinn-reciprocal``,
-``modified-blinn-phong``, ``neumann-phong`` and ``nielsen`` give
+``modified-blinn-phong``, ``neumann-phong``, ``nielsen``, ``nh-power-series`` and
+``lafortune`` (the last two generated for their number of lobes:
+:mod:`brdfkit.models.lobe_series`) give
 ``BRDF.formulas()``: one formula per model is the Numba kernel of ``model.eval`` and
 the function Mitsuba traces. Checked here, for every example of each model:
 
 - the compiled formula against the papers' closed forms written again in NumPy
-  (Nielsen eqs. 1-3, Lewis eqs. 5, 6, 8, 24, Neumann eq. 22; references below), also
+  (Nielsen eqs. 1-3, Lewis eqs. 5, 6, 8, 24 and §7, Neumann eqs. 7 and 22; references
+  below), also
   at θ = 90° and below the horizon (0 there);
 - the formula sampler against ``model.sample`` (its NumPy strategies: ``Mixture`` of
   ``COSINE``, ``CosPowerAxis``, ``HalfVector(PowerHalf)``) for the same (u₀, u₁), and
@@ -14,12 +17,11 @@ the function Mitsuba traces. Checked here, for every example of each model:
 - the Dr.Jit-traced versions inside Mitsuba (``llvm_ad_rgb``): eval, pdf and sample
   against the float64 NumPy/Numba values to float32 rounding, and that the bridge takes
   the traced route (no ``wavefront()`` needed);
-- Mitsuba's own χ² harness on the traced sampler of a Blinn model and of ``nielsen``
-  (cosine + cosˢ mirror lobe + N·H lobe). ``modified-phong`` and ``phong`` go through
-  the same harness in tests/test_render_mitsuba.py, now on the traced route.
-
-``nh-power-series`` (a loop over its terms) and ``phong-energy-conserving`` (a table
-lookup) give no formulas yet.
+- Mitsuba's own χ² harness on the traced sampler of a Blinn model, of ``nielsen``
+  (cosine + cosˢ mirror lobe + N·H lobe), of a three-term ``nh-power-series`` and of a
+  two-lobe ``lafortune`` (per-ω_o weights, an off-specular and a retro-reflective lobe).
+  ``modified-phong`` and ``phong`` go through the same harness in
+  tests/test_render_mitsuba.py, now on the traced route.
 """
 
 from __future__ import annotations
@@ -34,7 +36,7 @@ import pytest
 import brdfkit
 
 MODELS = ("modified-phong", "phong", "blinn", "phong-blinn-reciprocal",
-          "modified-blinn-phong", "neumann-phong", "nielsen")
+          "modified-blinn-phong", "neumann-phong", "nielsen", "nh-power-series", "lafortune")
 CASES = [(name, j) for name in MODELS
          for j in range(len(type(brdfkit.model(name)).examples))]
 
@@ -58,6 +60,11 @@ def _pairs(rng, k: int = 400):
     return wi, wo
 
 
+def _n_max(v: dict) -> float:
+    """The largest exponent (n, per lobe for the series; s of nielsen)."""
+    return max(float(np.max(v.get("n", 0.0))), float(v.get("s", 0.0)))
+
+
 # --------------------------------------------------------------------------- references
 def _reference(name: str, v: dict, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
     """f_r from the papers' equations in NumPy (float64), for channel values *v*."""
@@ -78,6 +85,13 @@ def _reference(name: str, v: dict, wi: np.ndarray, wo: np.ndarray) -> np.ndarray
         f = v["k_d"] + v["k_s"] * lobe(nh, v["n"])
     elif name == "modified-blinn-phong":  # Nielsen eq. (2)
         f = v["rho_d"] / math.pi + v["rho_s"] * (v["n"] + 8.0) / (8.0 * math.pi) * lobe(nh, v["n"])
+    elif name == "nh-power-series":  # Lewis §7: Σ_i k_i (N·H)^{n_i}
+        f = sum(k * lobe(nh, n) for k, n in zip(v["k_s"], v["n"], strict=True))
+    elif name == "lafortune":  # Neumann eq. (7): ρ_d/π + ρ_s Σ_j (C_xy L_xy·V_xy + C_z L_z V_z)^n
+        xy = wi[:, 0] * wo[:, 0] + wi[:, 1] * wo[:, 1]
+        f = v["rho_d"] / math.pi + v["rho_s"] * sum(
+            lobe(cxy * xy + cz * nl * nv, n)
+            for cxy, cz, n in zip(v["C_xy"], v["C_z"], v["n"], strict=True))
     elif name == "neumann-phong":  # Neumann eq. (22), c_n = (n+2)/2π by default
         c_n = (v["n"] + 2.0) / (2.0 * math.pi) if v["c_n"] is None else v["c_n"]
         f = c_n * lobe(rv, v["n"]) / np.maximum(np.maximum(nl, nv), 1e-300)
@@ -99,7 +113,7 @@ def test_formula_eval_is_the_closed_form(name, j):
     wi, wo = _pairs(np.random.default_rng(j + 17 * len(name)))
     v = m.channel_values(0)
     # a base rounded differently (R·V, (N·H)⁴) by a few ulp, raised to n: ~n·1e-15 relative
-    rtol = max(1e-12, 2e-15 * max(float(v.get("n", 0.0)), float(v.get("s", 0.0))))
+    rtol = max(1e-12, 2e-15 * _n_max(v))
     for c in range(m.packed.shape[0]):
         ref = _reference(name, m.channel_values(c), wi, wo)
         got = np.array([form.eval(*wi[k], *wo[k], m.packed[c]) for k in range(len(wi))])
@@ -166,7 +180,7 @@ def test_traced_matches_numpy(name, j):
     # float32 carries ~6e-8 relative per operation; a power n amplifies a base's error n
     # times: rtol 1e-4 up to n ≈ 100, 2e-7·n beyond (nielsen's N·H lobe has exponent 4s)
     v = m.channel_values(0)
-    n_max = max(float(v.get("n", 0.0)), 4.0 * float(v.get("s", 0.0)))
+    n_max = max(_n_max(v), 4.0 * float(v.get("s", 0.0)))
     rtol = max(1e-4, 2e-7 * n_max)
     f = m.eval(wi, wo)
     want = (f if f.ndim == 2 else f[:, None]) * np.maximum(wi[:, 2:3], 0.0)
@@ -202,6 +216,43 @@ def test_chi2_traced_sampler(props, wi):
     params = {k: v for k, v in props.items() if k != "model"}
     assert mitsuba_bsdf(brdfkit.model(props["model"], **params)).traced
     sample_func, pdf_func = BSDFAdapter("brdfkit", {"type": "brdfkit", **props}, wi=wi)
+    chi2 = ChiSquareTest(domain=SphericalDomain(), sample_func=sample_func,
+                         pdf_func=pdf_func, sample_dim=3, res=51, ires=4,
+                         sample_count=200_000)
+    assert chi2.run(), chi2.messages
+    gc.collect()
+
+
+@pytest.mark.parametrize("name,params,wi", [
+    ("nh-power-series", {"k_s": [0.1, 0.5, 5.0], "n": [0.0, 10.0, 200.0]}, [0.6, 0.0, 0.8]),
+    ("lafortune", {"rho_d": 0.2, "rho_s": 0.5, "C_xy": [-1.2, 0.6], "C_z": [0.8, 0.5],
+                   "n": [15.0, 3.0]}, [0.0, 0.6, 0.8]),
+])
+def test_chi2_traced_lobe_series_sampler(name, params, wi):
+    """Mitsuba's χ² harness on the traced sampler of the generated lobe sums (the bridge's
+    BSDF given directly: the plugin's flat properties take no per-lobe lists)."""
+    _llvm_rgb()
+    from mitsuba.chi2 import ChiSquareTest, SphericalDomain
+
+    bsdf = mitsuba_bsdf(brdfkit.model(name, **params))
+    assert bsdf.traced
+
+    def context(n):
+        si = dr.zeros(mi.SurfaceInteraction3f, n)
+        si.wi = wi
+        return si, mi.BSDFContext()
+
+    def sample_func(sample):
+        si, ctx = context(dr.width(sample))
+        bs, weight = bsdf.sample(ctx, si, sample[0], mi.Vector2f([sample[1], sample[2]]))
+        w = dr.full(mi.Float, 1.0, dr.width(weight))
+        w[dr.all(weight == 0)] = 0
+        return bs.wo, w
+
+    def pdf_func(wo):
+        si, ctx = context(dr.width(wo))
+        return bsdf.pdf(ctx, si, wo)
+
     chi2 = ChiSquareTest(domain=SphericalDomain(), sample_func=sample_func,
                          pdf_func=pdf_func, sample_dim=3, res=51, ires=4,
                          sample_count=200_000)

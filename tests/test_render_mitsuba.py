@@ -56,12 +56,14 @@ from scipy import stats
 
 import brdfkit
 from brdfkit.analysis import albedo
+from brdfkit.models import DerivedBRDF
 from brdfkit.pumping import pump
 
 mi = pytest.importorskip("mitsuba")
 dr = pytest.importorskip("drjit")
 
 from brdfkit.render.mitsuba_bridge import (  # noqa: E402
+    WavefrontRouteWarning,
     mitsuba_bsdf,
     spectral_model,
     use_variant,
@@ -312,6 +314,7 @@ def test_white_furnace(pumped):
     model = brdfkit.model("modified-phong", rho_d=0.2, rho_s=0.5, n=20.0)
     if pumped == "kulla-conty":
         model = brdfkit.compensate(model, "kulla-conty")
+        assert mitsuba_bsdf(model).traced  # its formulas (the wavefront route before)
     elif pumped:
         model = pump(model, g="max")
     imgs = renders(model, variant=variant, size=size, spp=spp, k=k, irradiance=0.0,
@@ -582,13 +585,13 @@ def test_traced_microfacet_against_roughconductor_and_numba():
     got = np.array(tb.eval(ctx, si, wo))[0]
     np.testing.assert_allclose(got, beck.eval(light, view) * light[:, 2], rtol=1e-4,
                                atol=1e-6 * got.max())
-    # a model without formulas (lafortune: a variable number of lobes, a loop) takes the
-    # wavefront route
-    pumped = brdfkit.model("lafortune")
-    assert pumped.formulas() is None
-    assert not mitsuba_bsdf(pumped).traced
+    # a model without formulas (a NumPy-only one) takes the wavefront route
+    plain = _NumpyOnly()
+    assert plain.formulas() is None
+    with pytest.warns(WavefrontRouteWarning, match="no formulas"):
+        assert not mitsuba_bsdf(plain).traced
     with pytest.raises(brdfkit.errors.ParameterError, match="route='traced' needs"):
-        mitsuba_bsdf(pumped, route="traced")
+        mitsuba_bsdf(plain, route="traced")
     del ours, tb
     gc.collect()
 
@@ -685,3 +688,15 @@ def test_one_pass_states_no_error_and_keeps_the_single_render():
         render_sphere(model, size=8, engine="mitsuba", spp=4, passes=5, phi_l=0.3)
     with pytest.raises(brdfkit.errors.ParameterError, match="takes no samples"):
         render_sphere(model, size=8, passes=2, phi_l=0.3)
+
+
+class _NumpyOnly(DerivedBRDF):
+    """A Lambertian evaluated in NumPy only (no kernel, no formulas): the wavefront route's
+    example."""
+
+    def __init__(self):
+        super().__init__(name="numpy-only", params=(), values={}, reciprocal=True)
+
+    def eval(self, wi, wo):
+        wi, wo = np.asarray(wi, dtype=float), np.asarray(wo, dtype=float)
+        return np.where((wi[..., 2] > 0) & (wo[..., 2] > 0), 1.0 / math.pi, 0.0)

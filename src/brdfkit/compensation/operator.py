@@ -25,8 +25,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from brdfkit._array import as_directions, as_uniform
-from brdfkit._dual import Formulas
-from brdfkit.compensation.kernels import kulla_conty_kernel, turquin_formula, turquin_kernel
+from brdfkit._dual import Formulas, numpy_version
+from brdfkit.compensation.kernels import (
+    WEIGHT_DEGREE,
+    kc_weight,
+    kulla_conty_formula,
+    kulla_conty_kernel,
+    kulla_conty_sampler,
+    turquin_formula,
+    turquin_kernel,
+)
 from brdfkit.compensation.table import compensation_table
 from brdfkit.errors import ParameterError
 from brdfkit.models._base import BRDF, DerivedBRDF, Lobe
@@ -34,6 +42,11 @@ from brdfkit.models.sampling import COSINE, Mixture, Strategy
 
 __all__ = ["METHODS", "CompensatedBRDF", "CompensationWarning", "Method", "compensate",
            "compensation_method"]
+
+
+#: Chebyshev nodes of the sampler weight's polynomial fit (kernels.WEIGHT_DEGREE + 1 would
+#: interpolate; 4× as many smooth it over Ẽ's steep rim)
+WEIGHT_NODES = 4 * (WEIGHT_DEGREE + 1)
 
 
 class CompensationWarning(UserWarning):
@@ -238,27 +251,42 @@ class CompensatedBRDF(DerivedBRDF):
         return s * (factor[..., 0] if np.ndim(s) == th.ndim else factor)
 
     def formulas(self) -> Formulas | None:
-        """Turquin with a base that gives formulas: eval composed with Ẽ read in the trace
-        (:func:`~brdfkit.compensation.kernels.turquin_formula`), the base's sampler (as
-        :meth:`sample`). None for Kulla–Conty: its sampler's mixture weight reads Ẽ(ω_o),
-        which a sampler formula (float arguments, no row) cannot."""
+        """With a base that gives formulas (and no tables of its own): eval composed with Ẽ
+        read in the trace (:func:`~brdfkit.compensation.kernels.turquin_formula`,
+        :func:`~brdfkit.compensation.kernels.kulla_conty_formula`); Turquin samples with the
+        base's sampler, Kulla–Conty with its mixture of the cosine and the base's sampler
+        (:func:`~brdfkit.compensation.kernels.kulla_conty_sampler`), as :meth:`sample`."""
         base = self.base.formulas()
-        if self.method != "turquin" or self.kernel is None or base is None \
-                or base.tables is not None:
+        if self.kernel is None or base is None or base.tables is not None:
             return None
         k = self.base.packed.shape[1]
-        return Formulas(eval=turquin_formula(base.eval, k, uniform=self.table.uniform),
-                        sample=base.sample, pdf=base.pdf, args=base.args, tables=k + 1)
+        if self.method == "turquin":
+            return Formulas(eval=turquin_formula(base.eval, k, uniform=self.table.uniform),
+                            sample=base.sample, pdf=base.pdf, args=base.args, tables=k + 1)
+        sample, pdf = kulla_conty_sampler(base.sample, base.pdf, len(base.args))
+        return Formulas(eval=kulla_conty_formula(base.eval, k, uniform=self.table.uniform),
+                        sample=sample, pdf=pdf, args=(*self._weight_args(), *base.args),
+                        tables=k + 1)
 
     # ---------------------------------------------------------------- sampling
+    def _weight_args(self) -> tuple:
+        """(F̄_ms, F̄_avg, q₀ … q₆) of :func:`~brdfkit.compensation.kernels.kc_weight`: the
+        channel means, and the least-squares polynomial in x = 2μ − 1 of the channel mean
+        of Ẽ(μ) at WEIGHT_NODES Chebyshev points (the weight steers variance only: a
+        formula sampler reads no table)."""
+        x = np.cos(np.pi * (np.arange(WEIGHT_NODES) + 0.5) / WEIGHT_NODES)
+        e = np.mean(self._e(0.5 * (x + 1.0)), axis=-1)
+        q = np.polynomial.polynomial.polyfit(x, e, WEIGHT_DEGREE)
+        return (float(np.mean(self.f_ms)), float(np.mean(self.f_avg)),
+                *(float(c) for c in q))
+
     def _strategy(self, wo: np.ndarray) -> Strategy:
         """Kulla–Conty: the base's sampler mixed with cos θ_i/π for f_ms, weighted by
         f_ms's share of the albedo at ω_o, F̄_ms(1 − E)/(F̄_ms(1 − E) + F̄_avg E) (channel
-        means; exact for F = 1, where the base's albedo is E)."""
-        e = np.mean(self._e(wo[..., 2]), axis=-1)
-        ms = float(np.mean(self.f_ms)) * (1.0 - e)
-        w = ms / np.maximum(ms + float(np.mean(self.f_avg)) * e, 1e-300)  # floor: E = 0
-        w = np.where(wo[..., 2] > 0.0, w, 0.0)
+        means; exact for F = 1, where the base's albedo is E; E the polynomial of
+        :meth:`_weight_args`, as the traced sampler reads it)."""
+        with np.errstate(all="ignore"):  # the discarded side of the weight's select
+            w = numpy_version(kc_weight)(wo[..., 2], *self._weight_args())
         return Mixture([COSINE, _BaseStrategy(self.base)], np.stack([w, 1.0 - w], axis=-1))
 
     def sample(self, wo, u):

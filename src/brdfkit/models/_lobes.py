@@ -47,10 +47,13 @@ from brdfkit.models.sampling import (
     lobes_pdf,
     lobes_sample,
     normalised_weights,
+    phong_lobe,
 )
 from brdfkit.models.specular import blinn_normal_albedo
 
-__all__ = ["COS_DIVISOR_FLOOR", "CosineLobeBRDF", "lobe_pow", "lobe_power", "lobe_mode",
+__all__ = ["COS_DIVISOR_FLOOR", "CosineLobeBRDF", "DiffuseLobeBRDF", "KdKsLobeBRDF",
+           "KdKsBlinnBRDF", "UP",
+           "lobe_pow", "lobe_power", "lobe_mode",
            "rv_dot", "nh_dot", "LOBE_AUTO", "LOBE_INTEGRAL", "LOBE_REAL"]
 
 RHO_D = DIFFUSE_PART  # ρ_d of the diffuse part beside a lobe (models/_params.py)
@@ -202,7 +205,7 @@ def channel_mean(x) -> float:
 
 
 _SLOTS = ("cosine", "phong", "blinn")  # the components of lobes_sample, in its order
-_UP = np.array([0.0, 0.0, 1.0])  # a wo for _strategy (the models' weights do not depend on it)
+UP = np.array([0.0, 0.0, 1.0])  # a wo for _strategy (the models' weights do not depend on it)
 
 
 def lobe_sampler_args(mixture: Mixture, layout: tuple) -> tuple:
@@ -260,7 +263,7 @@ class CosineLobeBRDF(StrategySampled, BRDF):
         if self.lobe_kernels is None:
             return None
         return Formulas(eval=self._lobe_kernel(), sample=lobes_sample, pdf=lobes_pdf,
-                        args=lobe_sampler_args(self._strategy(_UP), self.lobe_layout))
+                        args=lobe_sampler_args(self._strategy(UP), self.lobe_layout))
 
     @classmethod
     def width_from_beta(cls, beta: float) -> float:
@@ -268,19 +271,41 @@ class CosineLobeBRDF(StrategySampled, BRDF):
         return float(exponent_from_beta(beta))
 
 
-class KdKsBlinnBRDF(CosineLobeBRDF):
-    """Base of the k_d + k_s (N·H)ⁿ models (``blinn``, ``phong-blinn-reciprocal``): their
-    lobes (a diffuse one where k_d > 0 and the N·H lobe) and their sampler, the cosine and
-    the N·H lobe mixed in proportion to their normal-incidence albedos πk_d and
-    k_s ∫(N·H)ⁿ cos θ_o dω_o (:func:`blinn_normal_albedo`)."""
+class DiffuseLobeBRDF(CosineLobeBRDF):
+    """Base of the models of a diffuse part and one cosⁿ lobe: their lobes, a diffuse one
+    where :attr:`diffuse_param` is > 0 somewhere and the lobe of kind :attr:`lobe_kind`
+    whose exponent is the width parameter (:func:`lobe_hint`)."""
+
+    #: the diffuse part's parameter ("k_d", "rho_d")
+    diffuse_param = "k_d"
+    #: "mirror" (about the mirror of ω_o, phong_lobe) or "half" (N·H, blinn_lobe)
+    lobe_kind = "half"
 
     def lobes(self):
-        out = [Lobe("diffuse", math.pi / 2)] if np.any(self._values["k_d"]) else []
-        return out + [lobe_hint("half", self._values["n"])]
+        out = [Lobe("diffuse", math.pi / 2)] if np.any(self._values[self.diffuse_param]) else []
+        return out + [lobe_hint(self.lobe_kind, self._values[self.width_param])]
+
+
+class KdKsLobeBRDF(DiffuseLobeBRDF):
+    """Base of the k_d + k_s·lobe models (``phong``: the cosⁿ lobe about the mirror of ω_o;
+    ``blinn``, ``phong-blinn-reciprocal``: the (N·H)ⁿ lobe, :class:`KdKsBlinnBRDF`): their
+    lobes (a diffuse one where k_d > 0 and the lobe of kind :attr:`lobe_kind`) and their
+    sampler, the cosine and the lobe mixed in proportion to their normal-incidence albedos
+    πk_d and k_s ∫lobe cos θ_o dω_o (2π/(n+1) for the mirror lobe, whose division by N·L in
+    Lewis eq. 8 cancels the cosine; :func:`blinn_normal_albedo` for the N·H lobe)."""
 
     def _strategy(self, wo):
         v = self._values
         n = v["n"]
+        mirror = self.lobe_kind == "mirror"
+        k_s = channel_mean(v["k_s"])
         w = normalised_weights([math.pi * channel_mean(v["k_d"]),
-                                channel_mean(v["k_s"]) * blinn_normal_albedo(n)])
-        return Mixture([COSINE, blinn_lobe(n)], w)
+                                k_s * 2.0 * math.pi / (n + 1.0) if mirror
+                                else k_s * blinn_normal_albedo(n)])
+        return Mixture([COSINE, phong_lobe(n) if mirror else blinn_lobe(n)], w)
+
+
+class KdKsBlinnBRDF(KdKsLobeBRDF):
+    """Base of the k_d + k_s (N·H)ⁿ models (``blinn``, ``phong-blinn-reciprocal``)."""
+
+    lobe_kind = "half"

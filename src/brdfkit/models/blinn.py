@@ -34,7 +34,7 @@ import math
 import numba
 import numpy as np
 
-from brdfkit._dual import formula, select
+from brdfkit._dual import Formulas, formula, select
 from brdfkit._kern import INV_PI, below_horizon, n_dot_h
 from brdfkit.models._base import VECTOR_OPTIONS, Lobe, Param
 from brdfkit.models._lobes import (
@@ -46,6 +46,7 @@ from brdfkit.models._lobes import (
     RHO_D,
     RHO_S,
     CosineLobeBRDF,
+    DiffuseLobeBRDF,
     KdKsBlinnBRDF,
     lobe_hint,
     lobe_pow,
@@ -54,6 +55,7 @@ from brdfkit.models._lobes import (
 )
 from brdfkit.models._params import packed_indices
 from brdfkit.models._registry import register
+from brdfkit.models.lobe_series import nh_series_formulas
 from brdfkit.models.sampling import (
     COSINE,
     Mixture,
@@ -191,12 +193,20 @@ class NHPowerSeries(CosineLobeBRDF):
                for k, n in zip(v["k_s"], v["n"], strict=True) if k > 0.0]
         return out or [Lobe("diffuse", math.pi / 2)]
 
-    def _strategy(self, wo):
+    def _weights(self) -> np.ndarray:
+        """The mixture weights: each term's normal-incidence albedo k_i ∫(N·H)^{n_i} cos dω."""
         v = self.channel_values(0)
-        comps = [blinn_lobe(float(n)) for n in v["n"]]
-        w = normalised_weights([k * blinn_normal_albedo(n)
-                                for k, n in zip(v["k_s"], v["n"], strict=True)])
-        return Mixture(comps, w)
+        return normalised_weights([k * blinn_normal_albedo(n)
+                                   for k, n in zip(v["k_s"], v["n"], strict=True)])
+
+    def _strategy(self, wo):
+        comps = [blinn_lobe(float(n)) for n in self.channel_values(0)["n"]]
+        return Mixture(comps, self._weights())
+
+    def formulas(self) -> Formulas:
+        """f_r, the sampler of :meth:`_strategy` and its pdf as formulas unrolled for this
+        instance's number of terms (:mod:`brdfkit.models.lobe_series`)."""
+        return nh_series_formulas(self, self._weights())
 
 
 # --------------------------------------------------------------------------- Nielsen eq. (2)
@@ -228,7 +238,7 @@ def _modified_blinn_phong_int(ix, iy, iz, ox, oy, oz, p):
 
 
 @register
-class ModifiedBlinnPhong(CosineLobeBRDF):
+class ModifiedBlinnPhong(DiffuseLobeBRDF):
     """Modified Blinn–Phong: Nielsen et al. eq. (2), after Akenine-Möller et al. 2008.
 
     f_r = ρ_d/π + ρ_s (n+8)/(8π) (ω_h·n)ⁿ. The factor (n+8)/8π is an
@@ -273,9 +283,7 @@ class ModifiedBlinnPhong(CosineLobeBRDF):
         {"rho_d": [0.1, 0.2, 0.3], "rho_s": [0.5, 0.4, 0.3], "n": 2.0},
     )
 
-    def lobes(self):
-        out = [Lobe("diffuse", math.pi / 2)] if np.any(self._values["rho_d"]) else []
-        return out + [lobe_hint("half", self._values["n"])]
+    diffuse_param = "rho_d"
 
     def _strategy(self, wo):
         v = self._values

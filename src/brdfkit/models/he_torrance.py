@@ -7,6 +7,26 @@ directional-diffuse part as the kernel, the specular delta as
 :meth:`HeTorrance.specular_albedo`. Shadowing, effective roughness and the
 series of D are the free functions :func:`htsg_shadow`, :func:`htsg_sigma`,
 :func:`htsg_series`.
+
+The same as formulas (:mod:`brdfkit._dual`: the Mitsuba bridge's traced route), with
+fixed-length, branch-free forms of the two loops (:func:`he_torrance_formulas`):
+
+- the effective roughness σ: HTSG's equation for u = z₀/σ₀, √(π/2) u = A e^{−u²/2}, is
+  u² e^{u²} = B², B = A√(2/π), so u² = W(B²) (Lambert's W). W is computed from
+  L = ln B² by SIGMA_NEWTON_STEPS Newton steps on w + ln w = L (concave: from the first
+  step on the iterates approach the root from below, staying positive) from Winitzki's
+  start w₀ = ℓ(1 − ln(1 + ℓ)/(2 + ℓ)), ℓ = ln(1 + e^L), within 2 % of W everywhere;
+  the relative error squares per step (factor ≤ 1/2): ≤ 1e-15 after four
+  (:func:`htsg_sigma_formula`; tests/test_formulas_he_torrance.py checks it against
+  :func:`htsg_sigma`'s safeguarded Newton);
+- the series of D: written as T = S/g = Σ_{m≥1} e^{−g} g^{m−1}/(m!·m) e^{−a/m} (so that
+  G·S = (v·v)²(2πσ)² T needs no division by v_z and no small-g branch), summed upward
+  from m = 1 over a fixed number of terms N, the smallest whose tail bound
+  g^N/((N+1)!(N+1)(1 − g/(N+2))) is ≤ SERIES_TOL at the instance's largest
+  g = (4πσ₀)² (σ ≤ σ₀, v_z ≤ 2): |T_N − T| ≤ 1e-12·T(g, 0) (the lobe's value at its
+  peak for that g; relative to the local value only where that is not ≪ the peak).
+  An instance that needs more than SERIES_MAX_TERMS terms (σ₀ ≳ 0.45) gives no
+  formulas: the bridge's wavefront route.
 """
 
 from __future__ import annotations
@@ -16,6 +36,8 @@ import math
 import numba
 import numpy as np
 
+from brdfkit._cache import memo
+from brdfkit._dual import Formulas, erfc, exp, formula, log, log1p, maximum, minimum, select, sqrt
 from brdfkit._kern import INV_PI, below_horizon
 from brdfkit.errors import ParameterError
 from brdfkit.fresnel import _fresnel_conductor
@@ -24,6 +46,7 @@ from brdfkit.models._base import BRDF, Lobe, Param
 from brdfkit.models._params import ETA, packed_indices
 from brdfkit.models._registry import register
 from brdfkit.models.microfacet_distributions import SQRT_PI, _HalfVectorSampling
+from brdfkit.models.ward import ward_pdf, ward_sample
 
 _jit = numba.njit(cache=True, inline="always")
 
@@ -137,6 +160,141 @@ def htsg_series(g: float, a: float) -> float:
         if q < 1.0 and w * q / (1.0 - q) <= SERIES_TOL * total:
             break
     return total
+
+
+# --------------------------------------------------------------------------- formulas
+#: Newton steps of the formula σ (module docstring): Winitzki's start is within 2 % of W
+#: (measured ≤ 1.9 %); the relative error e → e²/2 per step: 2e-2, 2e-4, 2e-8, 2e-16
+SIGMA_NEWTON_STEPS = 4
+#: L = ln B² above which Winitzki's ln(1 + e^L) is L (e^{−30} ≈ 1e-13 relative, below the
+#: Newton steps' reach), and below which W(e^L) = x(1 − x) (x = e^L ≤ 1e-13: the next term
+#: 1.5x³ is below float64's resolution of x)
+SIGMA_LOG_SPLIT = 30.0
+#: cap of L: never reached in float64 (A ≤ 1e300·erfc ≤ e^{691}, L ≤ 1383); in float32 an
+#: A that overflows (a cosine below 1e-38) gives L = inf: capped, σ finite (≈ σ₀/100)
+SIGMA_LOG_CAP = 1e4
+LOG_TWO_OVER_PI = math.log(2.0 / math.pi)
+TINY_COS = 1e-300  # the floor of _htsg_k, kept
+#: the longest series the formula sums (module docstring): beyond it the wavefront route
+SERIES_MAX_TERMS = 64
+TWO_PI = 2.0 * math.pi
+QUARTER_PI2 = 0.25 * math.pi * math.pi  # D = (π²τ²/4) Σ …
+SHADOW_GRAZING = 1e-8  # htsg_shadow's small-a limit, kept
+
+
+@formula
+def htsg_shadow_formula(cos_t, sigma0, tau):
+    """:func:`htsg_shadow` as a formula (its branches selects, the same operations)."""
+    sin_t = sqrt(maximum(0.0, 1.0 - cos_t * cos_t))  # clamp: rounding near the pole
+    pos = sin_t > 0.0
+    a = tau * cos_t / (2.0 * sigma0 * select(pos, sin_t, 1.0))  # 1.0: the normal (S = 1)
+    small = a < SHADOW_GRAZING  # grazing: S = a√π (1 + O(a))
+    b = select(small, 1.0, a)  # 1.0: the discarded lane stays finite
+    erfc_b = erfc(b)
+    lam = 0.5 * (exp(-b * b) / (b * SQRT_PI) - erfc_b)
+    s = select(small, a * SQRT_PI, (1.0 - 0.5 * erfc_b) / (lam + 1.0))
+    return select(cos_t <= 0.0, 0.0, select(pos, s, 1.0))
+
+
+@formula
+def htsg_k_formula(cos_t, sigma0, tau):
+    """:func:`_htsg_k`, K(θ) = tan θ erfc(τ cot θ/(2σ₀)), as a formula."""
+    c = maximum(cos_t, TINY_COS)  # floor: tan θ stays finite (< 1e300) at the horizon
+    s = sqrt(maximum(0.0, 1.0 - c * c))  # clamp: rounding near the pole
+    pos = s > 0.0
+    return select(pos, (s / c) * erfc(tau * c / (2.0 * sigma0 * select(pos, s, 1.0))), 0.0)
+
+
+@formula
+def _w_step(w, big_l):
+    """One Newton step on w + ln w = L: w (1 + L − ln w)/(1 + w)."""
+    return w * (1.0 + big_l - log(w)) / (1.0 + w)
+
+
+@formula
+def htsg_sigma_formula(cos_i, cos_r, sigma0, tau):
+    """:func:`htsg_sigma` as a formula: σ = σ₀/√(1 + u²), u² = W(B²) (module docstring)."""
+    a_coef = 0.25 * (htsg_k_formula(cos_i, sigma0, tau) + htsg_k_formula(cos_r, sigma0, tau))
+    live = a_coef > 0.0
+    big_l = minimum(2.0 * log(select(live, a_coef, 1.0)) + LOG_TWO_OVER_PI, SIGMA_LOG_CAP)
+    x = exp(minimum(big_l, SIGMA_LOG_SPLIT))
+    ell = select(big_l > SIGMA_LOG_SPLIT, big_l, log1p(x))
+    w = ell * (1.0 - log1p(ell) / (2.0 + ell))  # Winitzki's start
+    w = maximum(w, 1e-300)  # floor: ln w finite (the lanes that use the series below)
+    w = _w_step(w, big_l)
+    w = _w_step(w, big_l)
+    w = _w_step(w, big_l)
+    w = _w_step(w, big_l)  # SIGMA_NEWTON_STEPS
+    w = select(big_l < -SIGMA_LOG_SPLIT, x * (1.0 - x), w)  # W(x) = x − x² + O(x³)
+    return select(live, sigma0 / sqrt(1.0 + w), sigma0)
+
+
+def series_terms(g_max: float) -> int:
+    """The number N of terms of the formula's series for g ≤ *g_max*: the smallest with
+    tail bound g^N/((N+1)!(N+1)(1 − g/(N+2))) ≤ SERIES_TOL (module docstring), or
+    SERIES_MAX_TERMS + 1 when none up to SERIES_MAX_TERMS is."""
+    log_g = math.log(g_max) if g_max > 0.0 else -math.inf
+    for n in range(1, SERIES_MAX_TERMS + 1):
+        if n + 2 <= g_max:
+            continue
+        log_bound = (n * log_g - math.lgamma(n + 2.0) - math.log(n + 1.0)
+                     - math.log1p(-g_max / (n + 2.0)))
+        if log_bound <= math.log(SERIES_TOL):
+            return n
+    return SERIES_MAX_TERMS + 1
+
+
+_EVAL_SOURCE = '''"""brdfkit: generated he-torrance formula, {n} terms of D's series."""
+from brdfkit._dual import exp, formula, select, sqrt
+from brdfkit.fresnel import _fresnel_conductor
+from brdfkit.models.he_torrance import (INV_PI, QUARTER_PI2, TWO_PI, htsg_shadow_formula,
+                                        htsg_sigma_formula)
+
+
+@formula(cache={cache})
+def he_torrance_eval(ix, iy, iz, ox, oy, oz, p):
+    sigma0, tau, eta, kappa, rho_d = p[{p_sigma0}], p[{p_tau}], p[{p_eta}], p[{p_k}], p[{p_rho_d}]
+    live = (iz > 0.0) & (oz > 0.0)
+    sx = ix + ox
+    sy = iy + oy
+    sz = iz + oz
+    vv = sx * sx + sy * sy + sz * sz
+    sigma = htsg_sigma_formula(iz, oz, sigma0, tau)
+    q = TWO_PI * sigma
+    g = (q * sz) * (q * sz)
+    a = tau * tau * (TWO_PI * TWO_PI) * (sx * sx + sy * sy) / 4.0
+    # T = S/g: the terms e^(-g) g^(m-1)/m! (w) over m, times e^(-a/m)
+    w = exp(-g)
+    t = w * exp(-a)
+{terms}
+    geo_d = vv * vv * (q * q) * t * QUARTER_PI2 * tau * tau
+    s_i = htsg_shadow_formula(iz, sigma0, tau) / select(live, iz, 1.0)
+    s_r = htsg_shadow_formula(oz, sigma0, tau) / select(live, oz, 1.0)
+    cos_d = sqrt(vv) * 0.5
+    f = select(eta == 0.0, 1.0, _fresnel_conductor(cos_d, eta, kappa))
+    return select(live, f * geo_d * s_i * s_r * INV_PI + rho_d * INV_PI, 0.0)
+'''
+
+
+def _eval_source(n: int, cache: bool) -> str:
+    terms = "\n".join(f"    w = w * g / {m!r}\n    t = t + w / {m!r} * exp(-a / {m!r})"
+                      for m in (float(k) for k in range(2, n + 1)))
+    return _EVAL_SOURCE.format(n=n, cache=cache, terms=terms, p_sigma0=P_SIGMA0, p_tau=P_TAU,
+                               p_eta=P_ETA, p_k=P_K, p_rho_d=P_RHO_D)
+
+
+@memo(maxsize=SERIES_MAX_TERMS)  # one per series length
+def he_torrance_eval_formula(n: int):
+    """The generated eval formula summing *n* terms (module docstring), cached on disk
+    with the drivers (compiled in memory when the directory cannot be written)."""
+    from brdfkit.models._drivers import _load
+
+    module = _load(_eval_source(n, cache=True))
+    if module is not None:
+        return module.he_torrance_eval
+    ns: dict = {"__name__": f"brdfkit_generated_he_torrance_{n}"}
+    exec(compile(_eval_source(n, cache=False), "<brdfkit he-torrance formula>", "exec"), ns)
+    return ns["he_torrance_eval"]
 
 
 PARAMS = (
@@ -268,16 +426,28 @@ class HeTorrance(_HalfVectorSampling, BRDF):
     reciprocal = True
     has_sampler = True
     kernel = _he_torrance
-    #: why :meth:`formulas` is None (the Mitsuba bridge's wavefront route, which renders the
-    #: directional-diffuse kernel and warns that the delta spike is not rendered)
-    wavefront_reason = ("the series of D and the effective roughness σ (an iterative root) "
-                        "are loops of data-dependent length: not a branch-free formula")
     examples = (
         {},
         {"sigma0": 0.02, "tau": 10.0},
         {"sigma0": 0.3, "tau": 3.0, "eta": [0.2, 0.9, 1.1], "k": [3.9, 2.4, 2.2],
          "rho_d": [0.05, 0.05, 0.1]},
     )
+
+    def _series_terms(self) -> int:
+        """Terms of the formula's series at this σ₀ (largest g = (4πσ₀)²)."""
+        return series_terms((4.0 * math.pi * float(np.max(self._values["sigma0"]))) ** 2)
+
+    def formulas(self) -> Formulas | None:
+        """f_r (the directional-diffuse and uniform-diffuse parts; the delta spike is not a
+        formula: the bridge warns) with σ and D's series of fixed length (module
+        docstring), and the cosine + Beckmann sampler of ``_strategy``
+        (:func:`~brdfkit.models.ward.ward_sample`, the same mixture); None beyond
+        SERIES_MAX_TERMS terms."""
+        n = self._series_terms()
+        if n > SERIES_MAX_TERMS:
+            return None
+        return Formulas(eval=he_torrance_eval_formula(n), sample=ward_sample, pdf=ward_pdf,
+                        args=(self._sampling_m(), self._p_diffuse()))
 
     def _sampling_m(self) -> float:
         v = self._values

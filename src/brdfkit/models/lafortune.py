@@ -6,7 +6,9 @@ A sum of lobes max(0, C_xy (ix·ox + iy·oy) + C_z iz·oz)ⁿ (Lafortune et al.
 1997, Neumann et al. eq. 7): off-specular, retro-reflective and
 normal-centred lobes in one reciprocal form. Sampled by a mixture of the
 cosine and, per lobe, the cosⁿ lobe about its own axis
-(:class:`brdfkit.models.sampling.CosPowerAxis`) with weights per ω_o.
+(:class:`brdfkit.models.sampling.CosPowerAxis`) with weights per ω_o. Its formulas
+(the Mitsuba bridge's traced route) are generated for the instance's number of lobes
+(:mod:`brdfkit.models.lobe_series`).
 
 Public objects
 --------------
@@ -29,11 +31,13 @@ import numba
 import numpy as np
 
 from brdfkit._array import stack
+from brdfkit._dual import Formulas
 from brdfkit._kern import INV_PI, below_horizon
 from brdfkit.errors import ParameterError
 from brdfkit.models._base import Lobe, Param
 from brdfkit.models._lobes import RHO_D, CosineLobeBRDF, channel_mean, lobe_hint, lobe_pow
 from brdfkit.models._registry import register
+from brdfkit.models.lobe_series import lafortune_formulas
 from brdfkit.models.sampling import COSINE, Mixture, log_mixture_weights, phong_lobe
 
 __all__ = ["Lafortune"]
@@ -44,8 +48,8 @@ __all__ = ["Lafortune"]
 def _lafortune(ix, iy, iz, ox, oy, oz, p):
     if below_horizon(iz, oz):
         return 0.0
-    m = int(p[0])
-    rho_d, rho_s = p[1], p[2]
+    rho_d, rho_s = p[0], p[1]
+    m = int(p[2])
     xy = ix * ox + iy * oy
     zz = iz * oz
     acc = 0.0
@@ -117,9 +121,6 @@ class Lafortune(CosineLobeBRDF):
     reciprocal = True
     width_param = "n"
     kernel = _lafortune
-    #: why :meth:`formulas` is None (the Mitsuba bridge's wavefront route)
-    wavefront_reason = ("a variable number of lobes (a loop over them) and a per-ω_o mixture "
-                        "of as many samplers: not a branch-free formula")
     # (C_xy, C_z) → t·(C_xy, C_z), ρ_s → ρ_s / tⁿ leaves the first lobe and the others
     # unchanged: a fit holds C_z of the first lobe (at its given value, default 1: the
     # scale goes into ρ_s, the direction into C_xy / C_z)
@@ -145,10 +146,12 @@ class Lafortune(CosineLobeBRDF):
             )
 
     def _pack_channel(self, v):
-        row = [float(self.n_lobes()), float(v["rho_d"]), float(v["rho_s"])]
+        # ρ_d, ρ_s in their parameters' slots (the Mitsuba bridge exposes them by slot),
+        # then the number of lobes and the lobes
+        row = [float(v["rho_d"]), float(v["rho_s"]), float(self.n_lobes())]
         for name in ("C_xy", "C_z", "n"):
             row.extend(np.asarray(v[name], dtype=np.float64).tolist())
-        return row  # the kernel reads the number of lobes first
+        return row
 
     def lobes(self):
         v = self.channel_values(0)
@@ -159,6 +162,11 @@ class Lafortune(CosineLobeBRDF):
             lb = lobe_hint(kind, float(n))
             out.append(lb if kind != "diffuse" else Lobe("diffuse", lb.width))
         return out
+
+    def formulas(self) -> Formulas:
+        """f_r, the sampler of :meth:`_strategy` and its pdf as formulas unrolled for this
+        instance's number of lobes (:mod:`brdfkit.models.lobe_series`)."""
+        return lafortune_formulas(self)
 
     def _strategy(self, wo):
         v = self.channel_values(0)

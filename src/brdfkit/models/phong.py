@@ -57,7 +57,7 @@ import numba
 import numpy as np
 
 from brdfkit._cache import memo
-from brdfkit._dual import Formulas, cos, formula, maximum, minimum, power, select, sin, sqrt
+from brdfkit._dual import Formulas, formula, maximum, power, select, sqrt
 from brdfkit._kern import INV_PI, INV_TWO_PI, below_horizon, n_dot_h, r_dot_v
 from brdfkit.halfangle import beta_from_exponent
 from brdfkit.models._base import VECTOR_OPTIONS, Lobe, Param
@@ -70,12 +70,15 @@ from brdfkit.models._lobes import (
     N_EXP,
     RHO_D,
     RHO_S,
+    UP,
     CosineLobeBRDF,
     KdKsBlinnBRDF,
+    KdKsLobeBRDF,
     channel_mean,
     lobe_hint,
     lobe_pow,
     lobe_power,
+    lobe_sampler_args,
     nh_dot,
     rv_dot,
 )
@@ -86,6 +89,8 @@ from brdfkit.models.sampling import (
     Mixture,
     blinn_lobe,
     diffuse_fraction,
+    lobes_pdf,
+    lobes_sample,
     normalised_weights,
     pdf_blinn_lobe,
     pdf_phong_lobe,
@@ -261,7 +266,7 @@ def _blinn_int(ix, iy, iz, ox, oy, oz, p):
 
 
 @register
-class Phong(CosineLobeBRDF):
+class Phong(KdKsLobeBRDF):
     """The original Phong shader as a BRDF: Lewis eqs. (5) and (8).
 
     f_r(S, V) = k_d + k_s F_s^P(S, V)/(N·S), F_s^P = max(0, R_l·V)ⁿ with
@@ -303,16 +308,7 @@ class Phong(CosineLobeBRDF):
         {"k_d": [0.05, 0.1, 0.15], "k_s": [1.0, 0.5, 0.25], "n": 3.0},
     )
 
-    def lobes(self):
-        out = [Lobe("diffuse", math.pi / 2)] if np.any(self._values["k_d"]) else []
-        return out + [lobe_hint("mirror", self._values["n"])]
-
-    def _strategy(self, wo):
-        v = self._values
-        n = v["n"]
-        w = normalised_weights([math.pi * channel_mean(v["k_d"]),
-                                channel_mean(v["k_s"]) * 2.0 * math.pi / (n + 1.0)])
-        return Mixture([COSINE, phong_lobe(n)], w)
+    lobe_kind = "mirror"
 
 
 @register
@@ -462,18 +458,16 @@ class PhongEnergyConserving(CosineLobeBRDF):
     def formulas(self) -> Formulas:
         """The kernel as a formula (H_s read with :func:`brdfkit.tables.lookup`, the table
         from column :data:`P_HS_TABLE` on) and the sampler's mixture as formulas: the same
-        directions and density as :meth:`sample`/:meth:`pdf` (``_strategy``)."""
+        directions and density as :meth:`sample`/:meth:`pdf` (``_strategy``: the mixture
+        :func:`~brdfkit.models.sampling.lobes_sample` draws, as the other Phong models')."""
         blinn = self._values["lobe"] == "blinn"
-        return Formulas(eval=_pec_blinn if blinn else _pec_phong,
-                        sample=_pec_sample_blinn if blinn else _pec_sample_phong,
-                        pdf=_pec_pdf_blinn if blinn else _pec_pdf_phong,
-                        args=(float(self._weights()[0]), float(self._values["n"])),
+        layout = ("cosine", "blinn" if blinn else "phong")
+        return Formulas(eval=_pec_blinn if blinn else _pec_phong, sample=lobes_sample,
+                        pdf=lobes_pdf, args=lobe_sampler_args(self._strategy(UP), layout),
                         tables=P_HS_TABLE)
 
 
-# phong-energy-conserving as formulas (brdfkit._dual): eval, and the sampler of _strategy,
-# Mixture([COSINE, phong_lobe(n) or blinn_lobe(n)], (w_c, 1 − w_c)), direction for direction
-TWO_PI = 2.0 * math.pi
+# phong-energy-conserving's eval as a formula (brdfkit._dual); its sampler is lobes_sample
 #: floor of |L + V| in N·H (a discarded lane's divisor: L = −V; a live lane has L_z + V_z > 0)
 _LENGTH_FLOOR = 1e-30
 
@@ -504,88 +498,3 @@ def _pec_phong(ix, iy, iz, ox, oy, oz, p):
 @formula
 def _pec_blinn(ix, iy, iz, ox, oy, oz, p):
     return pec_eval(ix, iy, iz, ox, oy, oz, p, True)
-
-
-@formula
-def cos_power_about(ax, ay, az, u0, u1, n):
-    """A direction with density (n+1)/(2π) max(0, cos α)ⁿ about the unit axis (:func:`
-    ~brdfkit.models.sampling.sample_phong_lobe` in the frame of Duff et al. 2017,
-    :func:`brdfkit.geometry.frame_around`)."""
-    cos_a = power(u0, 1.0 / (n + 1.0))
-    sin_a = sqrt(maximum(0.0, 1.0 - cos_a * cos_a))  # clamp: rounding near cos_a = 1
-    phi = TWO_PI * u1
-    lx = sin_a * cos(phi)
-    ly = sin_a * sin(phi)
-    sign = select(az >= 0.0, 1.0, -1.0)
-    q = -1.0 / (sign + az)
-    r = ax * ay * q
-    return (lx * (1.0 + sign * ax * ax * q) + ly * r + cos_a * ax,
-            lx * sign * r + ly * (sign + ay * ay * q) + cos_a * ay,
-            -lx * sign * ax - ly * ay + cos_a * az)
-
-
-@formula
-def pec_sample(ox, oy, oz, u0, u1, w_c, n, blinn):
-    """:meth:`PhongEnergyConserving.sample`'s mixture: the cosine (Malley) where u₀ < w_c,
-    else the lobe (the cosine again for n = 0), u₀ rescaled into the picked interval."""
-    first = u0 < w_c
-    # divisors floored: each is > 0 on the side that uses it
-    u = minimum(maximum(select(first, u0 / maximum(w_c, 1e-30),
-                               (u0 - w_c) / maximum(1.0 - w_c, 1e-30)), 0.0), 1.0)
-    r = sqrt(u)
-    phi = TWO_PI * u1
-    cx = r * cos(phi)
-    cy = r * sin(phi)
-    cz = sqrt(maximum(0.0, 1.0 - cx * cx - cy * cy))  # clamp: rounding at the rim
-    if blinn:
-        hx, hy, hz = cos_power_about(0.0, 0.0, 1.0, u, u1, n)
-        d = 2.0 * (ox * hx + oy * hy + oz * hz)
-        lx, ly, lz = d * hx - ox, d * hy - oy, d * hz - oz
-    else:
-        lx, ly, lz = cos_power_about(-ox, -oy, oz, u, u1, n)
-    cosine = first | (n == 0.0)
-    return select(cosine, cx, lx), select(cosine, cy, ly), select(cosine, cz, lz)
-
-
-@formula
-def pec_pdf(ix, iy, iz, ox, oy, oz, w_c, n, blinn):
-    """Density of :func:`pec_sample` (``Mixture.pdf``): w_c cos⁺θ_i/π + (1 − w_c) p_lobe."""
-    if blinn:
-        hx = ix + ox
-        hy = iy + oy
-        hz = iz + oz
-        norm = sqrt(hx * hx + hy * hy + hz * hz)
-        m = select(hz < 0.0, -1.0, 1.0) / maximum(norm, _LENGTH_FLOOR)  # the upper h (fold)
-        hx, hy, hz = hx * m, hy * m, hz * m
-        c_oh = ox * hx + oy * hy + oz * hz
-        c_oh = select(c_oh < 0.0, -c_oh, c_oh)
-        ok = (norm > 0.0) & (c_oh > 0.0)
-        lobe = select(ok, (n + 1.0) / TWO_PI * power(maximum(hz, 0.0), n)
-                      / (4.0 * select(ok, c_oh, 1.0)), 0.0)
-    else:
-        c = ix * -ox + iy * -oy + iz * oz  # ω_i · mirror(ω_o)
-        lobe = (n + 1.0) / TWO_PI * power(maximum(c, 0.0), n)
-    lobe = select(n == 0.0, maximum(iz, 0.0) * INV_PI, lobe)  # phong_lobe(0): the cosine
-    p = w_c * maximum(iz, 0.0) * INV_PI + (1.0 - w_c) * lobe
-    return select(oz > 0.0, p, 0.0)  # StrategySampled: 0 for ω_o below the horizon
-
-
-@formula
-def _pec_sample_phong(ox, oy, oz, u0, u1, w_c, n):
-    return pec_sample(ox, oy, oz, u0, u1, w_c, n, False)
-
-
-@formula
-def _pec_sample_blinn(ox, oy, oz, u0, u1, w_c, n):
-    return pec_sample(ox, oy, oz, u0, u1, w_c, n, True)
-
-
-@formula
-def _pec_pdf_phong(ix, iy, iz, ox, oy, oz, w_c, n):
-    return pec_pdf(ix, iy, iz, ox, oy, oz, w_c, n, False)
-
-
-@formula
-def _pec_pdf_blinn(ix, iy, iz, ox, oy, oz, w_c, n):
-    return pec_pdf(ix, iy, iz, ox, oy, oz, w_c, n, True)
-

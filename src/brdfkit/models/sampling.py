@@ -80,7 +80,8 @@ __all__ = [
     "HalfVectorDistribution", "PowerHalf", "Mixture",
     "StrategySampled", "phong_lobe", "blinn_lobe", "sample_phong_lobe", "pdf_phong_lobe",
     "sample_blinn_lobe", "pdf_blinn_lobe", "diffuse_fraction", "split_uniform",
-    "normalised_weights", "log_mixture_weights", "malley", "cos_power_normal_sample",
+    "normalised_weights", "log_mixture_weights", "malley", "half_pdf_terms",
+    "cos_power_normal_sample",
     "cos_power_normal_pdf",
 ]
 
@@ -500,13 +501,10 @@ def lobes_sample(ox, oy, oz, u0, u1, w_c, w_p, w_b, n_p, n_b):
 
 
 @formula
-def lobes_pdf(ix, iy, iz, ox, oy, oz, w_c, w_p, w_b, n_p, n_b):
-    """Density of :func:`lobes_sample` over the sphere (:meth:`Mixture.pdf`, 0 when ω_o is at
-    or below the horizon): w_c cos⁺θ_i/π + w_p (n_p+1)/(2π) max(0, ω_i·R(ω_o))^{n_p}
-    + w_b (n_b+1)/(2π) (N·h)^{n_b}/(4|ω_o·h|), h the upper one of ±(ω_i + ω_o)/|ω_i + ω_o|
-    (:class:`HalfVector`, fold); an exponent 0 is the cosine's density."""
-    p_cos = maximum(iz, 0.0) / _PI  # pdf_cosine_hemisphere's operations
-    p_phong = (n_p + 1.0) / _TWO_PI * power(maximum(-ix * ox - iy * oy + iz * oz, 0.0), n_p)
+def half_pdf_terms(ix, iy, iz, ox, oy, oz):
+    """(h_z, 4|ω_o·h|, ok) of :meth:`HalfVector.pdf` (fold): h the upper one of
+    ±(ω_i + ω_o)/|ω_i + ω_o|; the density of a half-vector lobe p_h(h) is p_h/(4|ω_o·h|)
+    where ok (a sum and a cosine > 0; elsewhere 0), the divisor 4 where not ok (finite)."""
     sx = ix + ox
     sy = iy + oy
     sz = iz + oz
@@ -518,8 +516,19 @@ def lobes_pdf(ix, iy, iz, ox, oy, oz, w_c, w_p, w_b, n_p, n_b):
     hz = sz / m
     cos_oh = abs_(ox * hx + oy * hy + oz * hz)
     ok = ok & (cos_oh > 0.0)
-    p_half = select(ok, (n_b + 1.0) / _TWO_PI * power(maximum(hz, 0.0), n_b)
-                    / (4.0 * select(ok, cos_oh, 1.0)), 0.0)
+    return hz, 4.0 * select(ok, cos_oh, 1.0), ok
+
+
+@formula
+def lobes_pdf(ix, iy, iz, ox, oy, oz, w_c, w_p, w_b, n_p, n_b):
+    """Density of :func:`lobes_sample` over the sphere (:meth:`Mixture.pdf`, 0 when ω_o is at
+    or below the horizon): w_c cos⁺θ_i/π + w_p (n_p+1)/(2π) max(0, ω_i·R(ω_o))^{n_p}
+    + w_b (n_b+1)/(2π) (N·h)^{n_b}/(4|ω_o·h|), h the upper one of ±(ω_i + ω_o)/|ω_i + ω_o|
+    (:class:`HalfVector`, fold); an exponent 0 is the cosine's density."""
+    p_cos = maximum(iz, 0.0) / _PI  # pdf_cosine_hemisphere's operations
+    p_phong = (n_p + 1.0) / _TWO_PI * power(maximum(-ix * ox - iy * oy + iz * oz, 0.0), n_p)
+    hz, denom, ok = half_pdf_terms(ix, iy, iz, ox, oy, oz)
+    p_half = select(ok, (n_b + 1.0) / _TWO_PI * power(maximum(hz, 0.0), n_b) / denom, 0.0)
     p = (w_c * p_cos + w_p * select(n_p == 0.0, p_cos, p_phong)
          + w_b * select(n_b == 0.0, p_cos, p_half))
     return select(oz > 0.0, p, 0.0)
