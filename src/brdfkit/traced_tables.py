@@ -85,7 +85,7 @@ class TracedTables:
         bin: :func:`brdfkit.tables.row_at`), every channel combined. An index outside the
         tables' columns (a NaN from a discarded lane of a select included) reads 0 and
         never leaves the array (``dr.gather``'s mask)."""
-        j = i + float(self.shift)
+        j = i + float(self.shift) if self.shift else i
         ok = (j >= float(self.start)) & (j < float(self.width))  # NaN: False
         index = dr.uint32_array_t(self.float_type)
         col = index(dr.select(ok, j, 0.0))
