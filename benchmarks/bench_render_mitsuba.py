@@ -46,7 +46,9 @@ the bridge's traced ``spectral_model("microfacet", …)`` (parameters interpolat
 path's wavelengths).
 
 Each row: the median over ``--repeats`` renders (after one warm-up render that compiles
-the kernels), all rows in one process, side by side. The ratio column is the row's
+the kernels), all rows in one process, side by side; the symbolic rows' renders
+interleaved (a change of load falls on all of them alike), ``--traced-only`` leaves out
+the (slow) wavefront rows. The ratio column is the row's
 median over the native ``roughconductor`` (symbolic) median of its variant; the target
 of issue 11 is ≤ 2 for the bridge's microfacet. The script also checks that the bridge
 and the native images agree: the sum over the image of the differences of the two mean
@@ -100,29 +102,52 @@ def _irregular(values) -> dict:
 
 
 def time_rows(mi, rows, variant, args) -> dict:
-    """{name: (median seconds, images (R, S, S, C))} of each (name, make, wavefront) row."""
+    """{name: (median seconds, images (R, S, S, C))} of each (name, make, wavefront) row.
+
+    The symbolic rows' renders are interleaved (repeat r of every row, then repeat r + 1),
+    so that a change of the shared machine's load falls on every row alike; the wavefront
+    rows follow one by one (while a wavefront BSDF object is alive, Dr.Jit's symbolic
+    calls trace it too and fail)."""
     results = {}
-    order = [r for r in rows if not r[2]] + [r for r in rows if r[2]]  # symbolic first
-    for name, make, wave in order:
-        scene = mi.load_dict(sphere_scene(make(), phi_l=PHI_L, ambient=0.2, size=args.size,
-                                          variant=variant))
+    if args.traced_only:
+        rows = [r for r in rows if not r[2]]
 
-        def render(seed, scene=scene, wave=wave):
-            if wave:
-                with wavefront():
-                    return np.array(mi.render(scene, spp=args.spp, seed=seed))
-            return np.array(mi.render(scene, spp=args.spp, seed=seed))
+    def render(scene, seed, wave):
+        if wave:
+            with wavefront():
+                return np.array(mi.render(scene, spp=args.spp, seed=seed))
+        return np.array(mi.render(scene, spp=args.spp, seed=seed))
 
-        render(1000)  # warm-up: kernel compilation
-        times, images = [], []
+    def scene_of(make):
+        return mi.load_dict(sphere_scene(make(), phi_l=PHI_L, ambient=0.2, size=args.size,
+                                         variant=variant))
+
+    symbolic = [(name, scene_of(make)) for name, make, wave in rows if not wave]
+    for _, scene in symbolic:
+        render(scene, 1000, False)  # warm-up: kernel compilation
+    times = {name: [] for name, _ in symbolic}
+    images = {name: [] for name, _ in symbolic}
+    for r in range(args.repeats):
+        for name, scene in symbolic:
+            t0 = time.perf_counter()
+            images[name].append(render(scene, r, False))
+            times[name].append(time.perf_counter() - t0)
+    for name, _ in symbolic:
+        results[name] = (statistics.median(times[name]), np.stack(images[name]))
+    del symbolic
+    gc.collect()
+    for name, make, wave in rows:
+        if not wave:
+            continue
+        scene = scene_of(make)
+        render(scene, 1000, True)
+        t, im = [], []
         for r in range(args.repeats):
             t0 = time.perf_counter()
-            images.append(render(r))
-            times.append(time.perf_counter() - t0)
-        results[name] = (statistics.median(times), np.stack(images))
-        # the wavefront route's BSDF objects are dropped after their row: while one is
-        # alive, Dr.Jit's symbolic calls (the symbolic rows) trace it too and fail
-        del scene, render
+            im.append(render(scene, r, True))
+            t.append(time.perf_counter() - t0)
+        results[name] = (statistics.median(t), np.stack(im))
+        del scene  # dropped after its row (the symbolic calls above)
         gc.collect()
     return results
 
@@ -135,11 +160,15 @@ def report(results, rows, variant, args, pairs, same, twins=None) -> None:
     print(f"{'renderer':44s} {'median s':>9s} {'ratio':>7s}"
           + (f" {'vs twin':>8s}  twin" if twins else ""))
     for name, _, _ in rows:
+        if name not in results:
+            continue  # --traced-only
         t = results[name][0]
         twin = twins.get(name)
         extra = f" {t / results[twin][0]:8.2f}  {twin}" if twin else ""
         print(f"{name:44s} {t:9.3f} {t / base:7.2f}{extra}")
     for a, b in pairs:  # agreement: the image sums within 3 standard errors
+        if a not in results or b not in results:
+            continue  # --traced-only
         ia, ib = results[a][1], results[b][1]
         d = ia.mean(axis=0) - ib.mean(axis=0)
         var = (ia.var(axis=0, ddof=1) + ib.var(axis=0, ddof=1)) / args.repeats
@@ -147,6 +176,8 @@ def report(results, rows, variant, args, pairs, same, twins=None) -> None:
         print(f"agreement {b} vs {a}: mean difference {d.mean():+.2e}, z = {z:+.2f}"
               f"{'' if abs(z) < 3 else '  <-- DISAGREE'}")
     for a, b in same:  # the same directions from the same numbers: equal images
+        if a not in results or b not in results:
+            continue  # --traced-only
         diff = np.abs(results[a][1] - results[b][1]).max()
         print(f"largest pixel difference, {a} vs {b} (same seeds): {diff:.2e}")
 
@@ -158,6 +189,9 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--sections", default="rgb,measured,ported,spectral",
                     help="comma-separated subset of rgb, measured, ported, spectral")
+    ap.add_argument("--traced-only", action="store_true",
+                    help="leave out the wavefront-route rows (slow; the images' agreement "
+                         "between the routes is then not checked)")
     args = ap.parse_args()
     sections = set(args.sections.split(","))
 

@@ -32,8 +32,10 @@ import numpy as np
 import pytest
 
 import brdfkit
+from brdfkit._dual import formula, muladd
 from brdfkit.data.measured import MeasuredBRDF
 from brdfkit.data.merl import read_binary, table_from_function, write_binary
+from brdfkit.tables import lookup, row_at
 
 SURROGATES = ["merl:nickel", "merl:nickel@npf", "merl:nickel@abc", "merl:nickel@sgd"]
 TABLES = ["file-nearest", "file-linear"]
@@ -172,13 +174,16 @@ def test_traced_eval_and_pdf(name, merl_file):
 
 
 def test_table_row_gathers_out_of_range_as_zero(merl_file):
-    """An index outside the table (a discarded lane's NaN included) reads 0, in bounds."""
-    from brdfkit.render.mitsuba_rows import traced_row
+    """An index outside the table (a discarded lane's NaN included) reads 0, in bounds; the
+    three channels of a bin are read from the one channel-interleaved array."""
+    from brdfkit.traced_tables import TableRow, TracedTables, row_at_drjit
 
     _llvm()
     model = MeasuredBRDF(merl_file)
-    row = traced_row(mi, dr, model.packed, model.formulas().table)
-    got = np.array(row.gather(mi.Float([0.0, 1.0, 1458000.0, 1458001.0, math.nan])))
+    k = model.formulas().tables
+    tabs = TracedTables(model.packed, k, mi.Float, lambda v: mi.Color3f(*v))
+    row = TableRow(list(model.packed[0, :k]), tabs)
+    got = np.array(row_at_drjit(dr)(row, mi.Float([0.0, 1.0, 1458000.0, 1458001.0, math.nan])))
     assert np.all(got[:, [0, 3, 4]] == 0.0)
     want = model.packed[:, [1, 1458000]]
     np.testing.assert_allclose(got[:, 1:3], want, rtol=1e-7)
@@ -215,3 +220,57 @@ def test_traced_render_agrees_with_wavefront(name, merl_file):
     p, level = worst_p(a, b=b)
     assert p > level, (p, level)
     assert worst_p(a, b=1.1 * b)[0] < level  # power: a 10 % brighter image is rejected
+
+
+def test_one_table_design_serves_lookups_and_bins():
+    """One row (traced_tables.TableRow) serves both kinds of table read in one formula: a
+    compensation-style cubic lookup (tables.lookup) and a measured-style bin read at a
+    computed column (tables.row_at); the trace equals the Numba formula on the packed row
+    (float32 tolerance). Reference: the compiled formula, an independent implementation
+    (tables._lookup and p[int(i)] in float64)."""
+    from brdfkit._dual import compose, drjit_version
+    from brdfkit.tables import build_lookup
+    from brdfkit.traced_tables import TableRow, TracedTables
+
+    _llvm()
+    fns = [lambda m, a=a: (1.0 + a * m * m)[:, None] for a in (0.5, 1.0, 2.0)]
+    blocks = [build_lookup(f).packed(0) for f in fns]
+    width = max(b.size for b in blocks)
+    k = 1  # one parameter column, then the lookup, then 8 bins per channel
+    bins = np.arange(24.0).reshape(3, 8) + 0.25
+    rows = np.array([np.concatenate([[2.0], blocks[c], np.zeros(width - blocks[c].size),
+                                     bins[c]]) for c in range(3)])
+    f = compose(_both, k=k, first_bin=k + width)
+    mu = np.array([0.0, 0.3, 0.71, 1.0])
+    got = np.array(drjit_version(f)(mi.Float(mu), mi.Float([0.0, 3.0, 5.0, 7.0]),
+                                    TableRow([2.0], TracedTables(rows, k, mi.Float,
+                                                                 lambda v: mi.Color3f(*v))))).T
+    want = np.array([[f(m, j, rows[c]) for c in range(3)]
+                     for m, j in zip(mu, [0.0, 3.0, 5.0, 7.0], strict=True)])
+    np.testing.assert_allclose(got, want, rtol=1e-6)
+
+
+k = first_bin = 0  # bound by compose in _both
+
+
+def _both(mu, j, p):
+    return p[0] * lookup(p, k, mu) + row_at(p, first_bin + j)
+
+
+def test_muladd_is_fused_in_the_trace_and_not_in_numba():
+    """muladd (the NBRDF net's multiply-adds): Numba a·b + c rounded twice (the kernels'
+    value), Dr.Jit one fused rounding. Reference: exact arithmetic of a = b = 1 + 2⁻¹²,
+    c = −1: a·b − 1 = 2⁻¹¹ + 2⁻²⁴ (exact in float32 when fused; the float32 product
+    rounds 2⁻²⁴ away, to even)."""
+    from brdfkit._dual import drjit_version
+
+    _llvm()
+    a = 1.0 + 2.0 ** -12
+    assert muladd(a, a, -1.0) == a * a - 1.0  # float64, unfused: the kernels' order
+    got = drjit_version(_fma_f)(mi.Float(a), mi.Float(a), mi.Float(-1.0))
+    assert float(np.array(got)[0]) == 2.0 ** -11 + 2.0 ** -24
+
+
+@formula
+def _fma_f(a, b, c):
+    return muladd(a, b, c)

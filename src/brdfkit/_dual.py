@@ -48,6 +48,8 @@ exp_nonpos      :func:`brdfkit._kern.exp_nonpos` ``dr.exp``
 erfc            ``math.erfc``                   Numerical Recipes' erfcc
                                                 (Chebyshev fit, relative
                                                 error < 1.2e-7: float32's)
+muladd(a,b,c)   ``a * b + c`` (unfused: the     ``dr.fma`` (fused: one
+                kernels' value)                 instruction, a rounding less)
 ==============  ==============================  ===========================
 
 plus those other modules register (:func:`primitive`), e.g. the Beckmann
@@ -81,7 +83,8 @@ from brdfkit._kern import exp_nonpos
 __all__ = ["Formulas", "formula", "compose", "primitive", "drjit_version", "select", "sqrt",
            "exp", "log",
            "log1p", "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "power", "floor",
-           "minimum", "maximum", "absolute", "exp_nonpos", "erfc", "numpy_version"]
+           "minimum", "maximum", "absolute", "exp_nonpos", "erfc", "muladd",
+           "numpy_version"]
 
 _jit = numba.njit(cache=True, inline="always")
 
@@ -208,6 +211,15 @@ def floor(x):
     return np.floor(x)
 
 
+# not inlined in Numba's IR (LLVM inlines it): a formula may call it hundreds of times, and
+# Numba's IR inlining of each call site is what costs compile time
+@numba.njit(cache=True)
+def muladd(a, b, c):
+    """a·b + c: unfused in Numba (the same value as the kernels' ``a * b + c``), one fused
+    multiply-add in Dr.Jit (a rounding less: float32 traces only gain)."""
+    return a * b + c
+
+
 sqrt = math.sqrt
 exp = math.exp
 log = math.log
@@ -255,7 +267,7 @@ for _obj, _factory in (
         (tan, lambda dr: dr.tan), (asin, lambda dr: dr.asin), (acos, lambda dr: dr.acos),
         (atan, lambda dr: dr.atan), (atan2, lambda dr: dr.atan2),
         (power, lambda dr: dr.power), (floor, lambda dr: dr.floor),
-        (exp_nonpos, lambda dr: dr.exp), (erfc, _erfc_drjit)):
+        (exp_nonpos, lambda dr: dr.exp), (erfc, _erfc_drjit), (muladd, lambda dr: dr.fma)):
     primitive(_obj, _factory)
 
 _CONSTANT_TYPES = (float, int, bool)
@@ -283,7 +295,8 @@ def drjit_version(f) -> Callable:
 
 #: NumPy counterparts of the primitives (arrays in, arrays out): ``numpy_version``
 _NUMPY_PRIMITIVES = {select: np.where, minimum: np.minimum, maximum: np.maximum,
-                     absolute: np.abs, power: np.power, floor: np.floor}
+                     absolute: np.abs, power: np.power, floor: np.floor,
+                     muladd: lambda a, b, c: a * b + c}
 _NUMPY_BY_NAME = {"sqrt": np.sqrt, "exp": np.exp, "log": np.log, "log1p": np.log1p,
                   "sin": np.sin, "cos": np.cos, "tan": np.tan, "asin": np.arcsin,
                   "acos": np.arccos, "atan": np.arctan, "atan2": np.arctan2,

@@ -20,13 +20,13 @@ model's divisor) needs, defined once:
    cubics on a two-level grid whose nodes include the function's kinks, with a
    verified margin so that it bounds the function from a chosen side.
 
-3. **The lookups as formula primitives** (:func:`lookup`, :func:`lookup_w`,
-   registered with :func:`brdfkit._dual.primitive`): a formula (:mod:`brdfkit._dual`)
-   that reads a table packed into its row calls them; Numba inlines :func:`_lookup`
-   / :func:`_lookup_w`, Dr.Jit (the Mitsuba bridge's traced route) runs the same
-   cubic read with ``dr.gather`` from the table rows held once as a Dr.Jit array
-   (:class:`~brdfkit.traced_tables.TracedTables`, carried by the row a traced
-   formula receives, :class:`~brdfkit.traced_tables.TableRow`;
+3. **The reads as formula primitives** (:func:`lookup`, :func:`lookup_w`,
+   :func:`row_at`, registered with :func:`brdfkit._dual.primitive`): a formula
+   (:mod:`brdfkit._dual`) that reads a table packed into its row calls them; Numba
+   inlines :func:`_lookup` / :func:`_lookup_w`, Dr.Jit (the Mitsuba bridge's traced
+   route) runs the same cubic read with ``dr.gather`` from the table rows held once
+   as a Dr.Jit array (:class:`~brdfkit.traced_tables.TracedTables`, carried by the
+   row a traced formula receives, :class:`~brdfkit.traced_tables.TableRow`;
    :mod:`brdfkit.traced_tables`).
 
 This is a low layer: it imports NumPy, Numba, :mod:`brdfkit.errors`,
@@ -42,8 +42,9 @@ Public objects
   single-level table uniform in √μ (4 reads, one square root, for a function smooth
   in √μ: a compensation's E(μ)).
 - :func:`lookup`, :func:`lookup_w` — the two reads as formula primitives (the offset
-  may be a float read from the row); :func:`row_from` — a row's tail, for a formula that
-  wraps another's.
+  may be a float read from the row); :func:`row_at` — the row at a computed column (a
+  bin of a measured table); :func:`row_from` — a row's tail, for a formula that wraps
+  another's.
 - :data:`LUT_TOL`, :data:`LUT_CELLS` — the lookup's default tolerance and cells.
 """
 
@@ -59,7 +60,7 @@ import numpy as np
 from brdfkit._dual import primitive
 from brdfkit._kern import clamp_unit, load_input
 from brdfkit.errors import BrdfkitError, ParameterError
-from brdfkit.traced_tables import lookup_drjit, lookup_w_drjit, row_from_drjit
+from brdfkit.traced_tables import lookup_drjit, lookup_w_drjit, row_at_drjit, row_from_drjit
 
 __all__ = [
     "LUT_CELLS",
@@ -70,6 +71,7 @@ __all__ = [
     "build_uniform_lookup",
     "lookup",
     "lookup_w",
+    "row_at",
     "row_from",
     "mu_of_w",
     "theta_of_w",
@@ -494,6 +496,15 @@ def row_from(p, n):  # pragma: no cover - compiled
     return p[n:]
 
 
+@numba.njit(cache=True, inline="always")
+def row_at(p, i):  # pragma: no cover - compiled
+    """``p[i]`` for a float *i* holding an exact integer index (a formula's computed bin:
+    a measured material's table, NPF's factors). Dr.Jit: the traced row's tables gathered
+    at *i*, 0 outside them (:meth:`~brdfkit.traced_tables.TracedTables.gather`)."""
+    return p[int(i)]
+
+
 primitive(lookup, lookup_drjit)
 primitive(lookup_w, lookup_w_drjit)
+primitive(row_at, row_at_drjit)
 primitive(row_from, row_from_drjit)

@@ -10,21 +10,20 @@ the half/difference angles as the reference reader computes them
 (:func:`merl_angles`: the operations of ``_merl_index._half_diff``, its branches
 selects), the bins of :mod:`brdfkit.data.merl`'s docstring (θ_h with MERL's
 square-root mapping), and the table read at the bin by
-:func:`~brdfkit.data.table_formulas.row_at` — in the trace a ``dr.gather`` from
-the table as one ``mi.Float`` array (:mod:`brdfkit.render.mitsuba_rows`):
+:func:`~brdfkit.tables.row_at` — in the trace a ``dr.gather`` from the table as
+one Dr.Jit array (:mod:`brdfkit.traced_tables`):
 
 - :func:`merl_nearest` — the reference reader's bin (``lookup="nearest"``);
 - :func:`merl_linear` — trilinear between bin centres (``lookup="linear"``): the
   eight corners in ``_linear_sum``'s order, unmeasured (NaN) corners left out and
   the other weights renormalised, NaN when all eight are unmeasured.
 
-Both give 0 at and below the horizon. The packed row is MeasuredBRDF's
-``[lookup mode, table (1,458,000 bins)]``; :func:`measured_formulas` returns
-:class:`~brdfkit.data.table_formulas.TableFormulas` whose table is the bins'
-columns. In float32 (Mitsuba's single-precision variants) a pair within rounding
-of a bin boundary can fall in the neighbouring bin: ``nearest`` then reads the
-neighbour's value (the lookup is discontinuous there), ``linear`` differs by
-rounding only.
+Both give 0 at and below the horizon. The packed row is MeasuredBRDF's ``[lookup
+mode, table (1,458,000 bins)]``; :func:`measured_formulas` returns
+``Formulas(tables=1)``: the bins are the row's tables. In float32 (Mitsuba's
+single-precision variants) a pair within rounding of a bin boundary can fall in
+the neighbouring bin: ``nearest`` then reads the neighbour's value (the lookup
+is discontinuous there), ``linear`` differs by rounding only.
 
 Sampler: the cosine + GGX proxy of the table's lobe
 (:mod:`brdfkit.user.proxy_sampler`), as for the surrogates
@@ -45,8 +44,8 @@ from __future__ import annotations
 
 import math
 
-from brdfkit._dual import acos, atan2, floor, formula, maximum, minimum, select, sqrt
-from brdfkit.data.table_formulas import TableFormulas, row_at
+from brdfkit._dual import Formulas, acos, atan2, floor, formula, maximum, minimum, select, sqrt
+from brdfkit.tables import row_at
 
 __all__ = ["measured_formulas", "merl_angles", "merl_nearest", "merl_linear"]
 
@@ -134,11 +133,11 @@ def merl_linear(ix, iy, iz, ox, oy, oz, p):
     return select(live, value, 0.0)
 
 
-def measured_formulas(model) -> TableFormulas:
+def measured_formulas(model) -> Formulas:
     """*model*'s (a MeasuredBRDF's) formulas: its lookup (module docstring), the cosine +
-    GGX proxy of its lobe as sampler and pdf; the table's columns for the traced row."""
+    GGX proxy of its lobe as sampler and pdf; the table from column TABLE on."""
     from brdfkit.user.proxy_sampler import proxy_args, proxy_pdf, proxy_sample
 
     f = merl_linear if model.values["lookup"] == "linear" else merl_nearest
-    return TableFormulas(eval=f, sample=proxy_sample, pdf=proxy_pdf, args=proxy_args(model),
-                         table=(TABLE, TABLE + N_BINS))
+    return Formulas(eval=f, sample=proxy_sample, pdf=proxy_pdf, args=proxy_args(model),
+                    tables=TABLE)

@@ -12,9 +12,8 @@ so that the Mitsuba bridge traces it into its kernel
 - **ABC**, **SGD**: the kernels' formulas with ``select`` for their branches;
   the same values as the kernels to rounding (tests/test_formulas_measured.py).
 - **NPF**: the 1-D factors read at their computed bins by
-  :func:`~brdfkit.data.table_formulas.row_at` (a gather in the trace); returned as
-  :class:`~brdfkit.data.table_formulas.TableFormulas` with the factor columns as
-  the table.
+  :func:`~brdfkit.tables.row_at` (a gather in the trace); returned with
+  ``Formulas(tables=2)``: the factors are the row's tables.
 - **NBRDF**: the 6-21-21-3 MLP unrolled: a formula generated once per network
   shape (:func:`nbrdf_formula`), each weight read from the packed row by a
   constant index (one generated source for every material; the weights are
@@ -61,7 +60,7 @@ from brdfkit._dual import (
     sqrt,
 )
 from brdfkit._kern import SMALL_LENGTH
-from brdfkit.data.table_formulas import TableFormulas, row_at
+from brdfkit.tables import row_at
 
 __all__ = ["surrogate_formulas", "abc_formula", "sgd_formula", "npf_formula", "nbrdf_formula",
            "half_unit", "fresnel_dielectric"]
@@ -154,7 +153,7 @@ def sgd_formula(ix, iy, iz, ox, oy, oz, p):
 
 # --------------------------------------------------------------------------- NPF
 _ND, _NG, _NF = 2, 92, 182  # surrogates: [ρ_d, ρ_s, D[90], G₁[90], F[90]]
-NPF_TABLE = (_ND, _NF + 90)
+NPF_TABLE = _ND  # the factors: the row's tables from this column on
 
 
 @formula
@@ -207,7 +206,7 @@ def nbrdf_features(ix, iy, iz, ox, oy, oz):
 #: The generated NBRDF formula's source: the net of surrogates.nbrdf_kernel unrolled, the
 #: sums in the kernel's order (so the same values), weights by constant index.
 _NBRDF_HEADER = '''"""brdfkit: generated NBRDF formula ({nh} hidden units; surrogate_formulas)."""
-from brdfkit._dual import formula, select
+from brdfkit._dual import formula, muladd, select
 from brdfkit.data.surrogate_formulas import nbrdf_features
 from brdfkit.data.table_formulas import expm1
 
@@ -219,19 +218,28 @@ def nbrdf_eval(ix, iy, iz, ox, oy, oz, p):
 '''
 
 
+def _dot(bias: str, terms: list[tuple[str, str]]) -> str:
+    """bias + Σ x·w in the kernel's order (left to right) as a chain of :func:`muladd`:
+    the same value in Numba (unfused), one fused multiply-add per weight in the trace."""
+    out = bias
+    for x, w in terms:
+        out = f"muladd({x}, {w}, {out})"
+    return out
+
+
 def _nbrdf_source(cache: bool) -> str:
     from brdfkit.data.surrogates import _B1, _B2, _B3, _NH, _W1, _W2, _W3
 
     lines = [_NBRDF_HEADER.format(nh=_NH, cache=cache)]
     for j in range(_NH):  # layer 1 (x1 = h_y = 0 is left out, as the kernel does)
-        terms = " + ".join(f"x{i} * p[{_W1 + i * _NH + j}]" for i in (0, 2, 3, 4, 5))
-        lines.append(f"    s = p[{_B1 + j}] + {terms}\n    a{j} = select(s > 0.0, s, 0.0)\n")
+        s = _dot(f"p[{_B1 + j}]", [(f"x{i}", f"p[{_W1 + i * _NH + j}]") for i in (0, 2, 3, 4, 5)])
+        lines.append(f"    s = {s}\n    a{j} = select(s > 0.0, s, 0.0)\n")
     for k in range(_NH):  # layer 2
-        terms = " + ".join(f"a{j} * p[{_W2 + _NH * j + k}]" for j in range(_NH))
-        lines.append(f"    s = p[{_B2 + k}] + {terms}\n    r{k} = select(s > 0.0, s, 0.0)\n")
+        s = _dot(f"p[{_B2 + k}]", [(f"a{j}", f"p[{_W2 + _NH * j + k}]") for j in range(_NH)])
+        lines.append(f"    s = {s}\n    r{k} = select(s > 0.0, s, 0.0)\n")
     for c in range(3):  # the output layer, one sum per channel
-        terms = " + ".join(f"r{k} * p[{_W3 + 3 * k + c}]" for k in range(_NH))
-        lines.append(f"    y{c} = p[{_B3 + c}] + {terms}\n")
+        y = _dot(f"p[{_B3 + c}]", [(f"r{k}", f"p[{_W3 + 3 * k + c}]") for k in range(_NH)])
+        lines.append(f"    y{c} = {y}\n")
     lines.append("    c = p[0]  # the row's channel\n"
                  "    f = expm1(select(c == 0.0, y0, select(c == 1.0, y1, y2)))\n"
                  "    # f_r = exp(y) − 1, clamped at 0 where the net dips below it (the kernel)\n"
@@ -265,7 +273,7 @@ def surrogate_formulas(model):
     rep = model.representation
     args = proxy_args(model)
     if rep == "npf":
-        return TableFormulas(eval=npf_formula, sample=proxy_sample, pdf=proxy_pdf, args=args,
-                             table=NPF_TABLE)
+        return Formulas(eval=npf_formula, sample=proxy_sample, pdf=proxy_pdf, args=args,
+                        tables=NPF_TABLE)
     f = nbrdf_formula() if rep == "nbrdf" else _ANALYTIC[rep]
     return Formulas(eval=f, sample=proxy_sample, pdf=proxy_pdf, args=args)

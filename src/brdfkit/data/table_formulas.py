@@ -1,33 +1,18 @@
 """
-Formulas that read a model's packed row at a computed index
-===========================================================
+Primitives of the measured materials' formulas
+==============================================
 
 The formula contract (:mod:`brdfkit._dual`) reads a packed row ``p`` by constant
-index only (``p[3]``): in Numba ``p`` is a float64 array, in the Mitsuba bridge's
-traced route a tuple of per-column values. A measured material's formula reads
-its *tables* (NPF's 1-D factors, a MERL table of 1,458,000 bins per channel) at an
-index computed from the directions; :func:`row_at` is that read, a primitive:
-
-==============  ====================================  =================================
-name            Numba                                 Dr.Jit
-==============  ====================================  =================================
-row_at(p, i)    ``p[int(i)]`` (*i* a float holding     ``p.gather(i)``: the traced row's
-                an exact integer)                     table as one ``mi.Float`` array,
-                                                      read with ``dr.gather``
-==============  ====================================  =================================
-
-A model whose formula calls :func:`row_at` returns :class:`TableFormulas`: the
-:class:`~brdfkit._dual.Formulas` plus ``table = (start, stop)``, the columns of the
-packed row that are read only through :func:`row_at` (between them the constant
-columns stay ordinary). The traced route (:mod:`brdfkit.render.mitsuba_rows`)
-turns those columns into one Dr.Jit array, once per BSDF, instead of one Python
-value per column (a MERL row has 1,458,001 columns), and passes a row object whose
-``[k]`` is column *k* for a constant *k* and whose ``gather(i)`` reads the table.
+index only (``p[3]``). A measured material's formula reads its *tables* (NPF's 1-D
+factors, a MERL table of 1,458,000 bins per channel) at an index computed from the
+directions: :func:`brdfkit.tables.row_at` (re-exported here), one of the table
+primitives that every table-reading model shares; the model declares where its
+tables start with ``Formulas(tables=K)``, and the traced route gathers them
+(:mod:`brdfkit.traced_tables`, the one design for tables in the trace).
 
 Public objects
 --------------
-- :func:`row_at` — the primitive (Numba function; Dr.Jit: the row's ``gather``).
-- :class:`TableFormulas` — :class:`~brdfkit._dual.Formulas` with the table's columns.
+- :func:`row_at` — :func:`brdfkit.tables.row_at` (Numba ``p[int(i)]``; Dr.Jit a gather).
 - :func:`expm1` — ``exp(x) − 1``, a primitive (Numba ``math.expm1``; Dr.Jit Kahan's
   form, accurate near 0).
 
@@ -40,28 +25,13 @@ References
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numba
 
-from brdfkit._dual import Formulas, primitive
+from brdfkit._dual import primitive
+from brdfkit.tables import row_at
 
-__all__ = ["row_at", "TableFormulas", "expm1"]
-
-
-@numba.njit(cache=True, inline="always")
-def row_at(p, i):
-    """``p[i]`` for a float *i* holding an exact integer index (a formula's computed bin)."""
-    return p[int(i)]
-
-
-def _row_at_drjit(dr):
-    def row_at_(p, i):
-        return p.gather(i)  # the traced route's row (brdfkit.render.mitsuba_rows)
-    return row_at_
-
-
-primitive(row_at, _row_at_drjit)
+__all__ = ["row_at", "expm1"]
 
 
 @numba.njit(cache=True, inline="always")
@@ -83,11 +53,3 @@ def _expm1_drjit(dr):
 
 
 primitive(expm1, _expm1_drjit)
-
-
-@dataclass(frozen=True)
-class TableFormulas(Formulas):
-    """:class:`~brdfkit._dual.Formulas` of a model that reads the packed row's columns
-    ``table = (start, stop)`` through :func:`row_at` (module docstring)."""
-
-    table: tuple | None = None

@@ -38,9 +38,10 @@ a model RGB channels only.
 Tables and parameters
 ---------------------
 A model whose formulas read tables (``Formulas.tables = K``: a pumped model's albedo
-lookups) gets its first K columns as above and the rest as one Dr.Jit array, gathered
-from by :func:`brdfkit.tables.lookup` (:class:`~brdfkit.traced_tables.TableRow`); a table per
-wavelength of a grid is not traced (:func:`wavefront_reason`). ``traverse`` lists the
+lookups, a measured material's bins) gets its first K columns as above and the rest as
+one Dr.Jit array, gathered from by the table primitives of :mod:`brdfkit.tables`
+(:class:`~brdfkit.traced_tables.TableRow`, the one design for tables in the trace); a
+table per wavelength of a grid is not traced (:func:`wavefront_reason`). ``traverse`` lists the
 model's scalar and grey/RGB colour parameters by name, as Dr.Jit values in the row the
 eval formula reads (differentiable unless the model has tables, which are rebuilt in
 NumPy); ``parameters_changed`` rebuilds the model (``with_params``) and its sampler's
@@ -58,7 +59,6 @@ import numpy as np
 
 from brdfkit._dual import drjit_version
 from brdfkit.models import BRDF
-from brdfkit.render.mitsuba_rows import TracedRow, traced_row
 from brdfkit.traced_tables import TableRow, TracedTables
 
 
@@ -79,10 +79,6 @@ def wavefront_reason(model: BRDF, variant: str, grid: np.ndarray | None) -> str 
     if not variant.startswith("llvm"):
         return f"{model.name}: the {variant} variant (the traced route needs an llvm_* one)"
     n_c = model.n_channels or 1
-    if getattr(form, "table", None) and not (  # a gathered table (data/table_formulas)
-            grid is None and "spectral" not in variant and n_c in (1, 3)):
-        return (f"{model.name}: a table gathered per channel is traced with grey or RGB "
-                f"channels in an RGB or mono variant, not {n_c} channels in {variant}")
     if n_c == 1:
         return None
     if "spectral" in variant:
@@ -145,13 +141,6 @@ def traced_class(mi, dr, variant: str) -> type:
             self.f_pdf = drjit_version(form.pdf)
             self.args = tuple(float(a) for a in form.args)
             packed = np.atleast_2d(model.packed)
-            table = getattr(form, "table", None)  # TableFormulas (data/): columns read by row_at
-            if table:
-                # the table's columns one Dr.Jit array, read by dr.gather (mitsuba_rows);
-                # the other columns constants: no parameter exposed, no gradient
-                self.columns, self.tables, self.differentiable = [], None, False
-                self.fixed = traced_row(mi, dr, packed, table)
-                return
             self.columns = _columns(packed[:, :form.tables])
             self.tables = None if form.tables is None else TracedTables(
                 packed, form.tables, mi.Float, _combine)
@@ -162,8 +151,6 @@ def traced_class(mi, dr, variant: str) -> type:
                                    for c in self.columns)
 
         def _params(self, si) -> tuple:
-            if isinstance(getattr(self, "fixed", None), TracedRow):
-                return self.fixed  # a model reading a gathered table (no grid: wavefront_reason)
             if self.grid is None:
                 row = list(self.fixed if kind != "spectral" else self.columns)
             else:
