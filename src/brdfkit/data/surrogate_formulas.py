@@ -40,7 +40,8 @@ Public objects
   formulas (``SurrogateBRDF.formulas``).
 - :func:`abc_formula`, :func:`sgd_formula`, :func:`npf_formula` — the kernels as formulas.
 - :func:`nbrdf_formula` — the generated NBRDF formula.
-- :func:`half_unit`, :func:`fresnel_dielectric` — shared formulas.
+- :func:`half_unit` — a shared formula (the dielectric Fresnel is
+  :mod:`brdfkit.fresnel`'s formula).
 """
 
 from __future__ import annotations
@@ -62,9 +63,10 @@ from brdfkit._dual import (
 )
 from brdfkit._kern import SMALL_LENGTH
 from brdfkit.data.table_formulas import TableFormulas, row_at
+from brdfkit.fresnel import _fresnel_dielectric as fresnel_dielectric
 
 __all__ = ["surrogate_formulas", "abc_formula", "sgd_formula", "npf_formula", "nbrdf_formula",
-           "half_unit", "fresnel_dielectric"]
+           "half_unit"]
 
 INV_PI = 1.0 / math.pi
 HALF_PI = 0.5 * math.pi
@@ -87,21 +89,6 @@ def half_unit(ix, iy, iz, ox, oy, oz):
     sx, sy, sz = sx * r, sy * r, sz * r
     length = sqrt(sx * sx + sy * sy + sz * sz)
     return sx / length, sy / length, sz / length
-
-
-@formula
-def fresnel_dielectric(c, eta):
-    """Unpolarised dielectric Fresnel reflectance (:func:`brdfkit.fresnel._fresnel_dielectric`,
-    its branch a select): 1 under total internal reflection."""
-    c = minimum(maximum(c, 0.0), 1.0)  # a cosine of unit vectors: clamp rounding
-    g2 = eta * eta + c * c - 1.0
-    tir = g2 <= 0.0
-    g = sqrt(select(tir, 1.0, g2))  # 1.0: the discarded lane stays finite
-    gpc = g + c
-    gmc = g - c
-    a = c * gpc - 1.0
-    b = c * gmc + 1.0
-    return select(tir, 1.0, 0.5 * (gmc * gmc) / (gpc * gpc) * (1.0 + (a * a) / (b * b)))
 
 
 # --------------------------------------------------------------------------- ABC
