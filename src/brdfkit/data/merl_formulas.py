@@ -27,7 +27,7 @@ neighbour's value (the lookup is discontinuous there), ``linear`` differs by
 rounding only.
 
 Sampler: the cosine + GGX proxy of the table's lobe
-(:mod:`brdfkit.user.proxy_sampler`), as for the surrogates
+(:mod:`brdfkit.models.proxy_sampler`), as for the surrogates
 (:mod:`brdfkit.data.surrogate_formulas`).
 
 Public objects
@@ -47,6 +47,7 @@ import math
 
 from brdfkit._dual import acos, atan2, floor, formula, maximum, minimum, select, sqrt
 from brdfkit.data.table_formulas import TableFormulas, row_at
+from brdfkit.models.proxy_sampler import proxy_args, proxy_pdf, proxy_sample
 
 __all__ = ["measured_formulas", "merl_angles", "merl_nearest", "merl_linear"]
 
@@ -137,8 +138,6 @@ def merl_linear(ix, iy, iz, ox, oy, oz, p):
 def measured_formulas(model) -> TableFormulas:
     """*model*'s (a MeasuredBRDF's) formulas: its lookup (module docstring), the cosine +
     GGX proxy of its lobe as sampler and pdf; the table's columns for the traced row."""
-    from brdfkit.user.proxy_sampler import proxy_args, proxy_pdf, proxy_sample
-
     f = merl_linear if model.values["lookup"] == "linear" else merl_nearest
     return TableFormulas(eval=f, sample=proxy_sample, pdf=proxy_pdf, args=proxy_args(model),
                          table=(TABLE, TABLE + N_BINS))

@@ -30,7 +30,7 @@ largest component: equal to rounding), the cosines clamped to [0, 1] before
 
 Samplers: these materials' own samplers are tabulated (:mod:`brdfkit.data.sampler`),
 not formulas. Their traced sampler is the cosine + GGX proxy of
-:mod:`brdfkit.user.proxy_sampler` fitted to the material's lobe (its pdf is the
+:mod:`brdfkit.models.proxy_sampler` fitted to the material's lobe (its pdf is the
 density of its samples: Monte-Carlo estimates stay unbiased; only the variance
 differs from the tabulated sampler's).
 
@@ -64,6 +64,7 @@ from brdfkit._dual import (
 from brdfkit._kern import SMALL_LENGTH
 from brdfkit.data.table_formulas import TableFormulas, row_at
 from brdfkit.fresnel import _fresnel_dielectric as fresnel_dielectric
+from brdfkit.models.proxy_sampler import proxy_args, proxy_pdf, proxy_sample
 
 __all__ = ["surrogate_formulas", "abc_formula", "sgd_formula", "npf_formula", "nbrdf_formula",
            "half_unit"]
@@ -247,8 +248,6 @@ _ANALYTIC = {"abc": abc_formula, "sgd": sgd_formula}
 def surrogate_formulas(model):
     """*model*'s (a SurrogateBRDF's) Formulas: its f_r as a formula (module docstring), the
     cosine + GGX proxy of its lobe as sampler and pdf."""
-    from brdfkit.user.proxy_sampler import proxy_args, proxy_pdf, proxy_sample
-
     rep = model.representation
     args = proxy_args(model)
     if rep == "npf":
