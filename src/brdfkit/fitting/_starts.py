@@ -61,18 +61,25 @@ def off_the_bounds(run, values: dict, *, inside: bool = False) -> dict:
     included) whose projected loss on the search's samples is least: from the bound the
     simplex cannot move it (a conductor's κ at its default 0 stayed there whatever η; held
     η = 1.8 on nickel, κ ended at its floor with the albedo 92 % low). The start is never
-    worse than at the bound, which is one of the candidates. *inside*: the bounds are not
-    candidates (the defaults' start: with the guess at a bound, the multi-start then tries
-    the best interior basin too; η = 1.8 held on nickel: κ = 100 at the guess's width,
-    κ ≈ 3.7 the better optimum, 0.00975 against 0.00997)."""
+    worse than at the bound, which is one of the candidates. *inside*: the best local
+    minimum of the scan inside the range (else its least inside value), not a bound (the
+    defaults' start: with the guess at a bound, the multi-start then tries an interior
+    basin too; η = 1.8 held on nickel: κ = 100 at the guess's width, κ ≈ 3.7 the better
+    optimum, 0.00975 against 0.00997)."""
     space = run.space
     for name in space.names(run.shape):
         cs = [c for c in run.shape if c.name == name]
         if not np.all(np.abs(space.z(values, cs)) >= SATURATED_Z):
             continue
-        best_z = min(OFF_BOUND_Z[1:-1] if inside else OFF_BOUND_Z, key=lambda zz: run.projected(
-            run.sp, space.point(np.full(len(cs), zz), cs, values)))
-        values = space.point(np.full(len(cs), best_z), cs, values)
+        loss = [run.projected(run.sp, space.point(np.full(len(cs), zz), cs, values))
+                for zz in OFF_BOUND_Z]
+        if inside:  # the best basin inside: a local minimum of the scan, else the least
+            inner = range(1, len(OFF_BOUND_Z) - 1)
+            basins = [j for j in inner if loss[j] < loss[j - 1] and loss[j] < loss[j + 1]]
+            pick = min(basins or inner, key=lambda j: loss[j])
+        else:
+            pick = int(np.argmin(loss))
+        values = space.point(np.full(len(cs), OFF_BOUND_Z[pick]), cs, values)
     return values
 
 
