@@ -39,6 +39,11 @@ LAYER = {
     "fitting": 3, "render": 3,
     "figures": 4, "cli": 4, "report": 4, "explorer": 4, "__main__": 4,
 }
+#: Packages of layer 2 that the table of docs/architecture.md restricts further: they import
+#: layers 0–1 only (and themselves), not the rest of their own layer — analysis does not
+#: know materials (data), operators or specs; data (measured materials) knows neither the
+#: analyses nor the user's models (the proxy sampler its formulas use is models/, layer 1)
+BELOW_ONLY = {"analysis": 1, "data": 1}
 MAX_LINES = 600
 #: hooks of the model protocol that must be read as declared attributes, never probed
 HOOKS = {"isotropic", "specular_albedo", "albedo_kinks", "albedo_kinks_nv", "albedo_kink_mus",
@@ -84,6 +89,10 @@ def test_imports_go_down_only(path):
         assert LAYER[other] <= LAYER[top], (
             f"{path}:{node.lineno}: layer {LAYER[top]} ({top or 'brdfkit'}) imports "
             f"brdfkit.{other} of layer {LAYER[other]} (docs/architecture.md)")
+        if top in BELOW_ONLY and other != top:
+            assert LAYER[other] <= BELOW_ONLY[top], (
+                f"{path}:{node.lineno}: {top} imports brdfkit.{other or '(the root)'}; it "
+                f"may import layers 0-{BELOW_ONLY[top]} only (docs/architecture.md)")
 
 
 @pytest.mark.parametrize("path", _modules(), ids=lambda p: str(p.relative_to(SRC)))

@@ -16,8 +16,6 @@ References (independent of the code under test):
 from __future__ import annotations
 
 import gc
-import math
-import warnings
 
 import numpy as np
 import pytest
@@ -120,24 +118,14 @@ def test_formula_kernel_equals_paper_and_eval(name, k, ex, rng):
 mi = pytest.importorskip("mitsuba")
 dr = pytest.importorskip("drjit")
 
-from brdfkit.render.mitsuba_bridge import mitsuba_bsdf, use_variant  # noqa: E402
+from traced_helpers import float32_hemisphere as _hemisphere  # noqa: E402
+from traced_helpers import variant  # noqa: E402
+
+from brdfkit.render.mitsuba_bridge import mitsuba_bsdf  # noqa: E402
 
 
 def _variant(name):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        v = use_variant(name)
-    if not v.startswith("llvm"):
-        pytest.skip("the traced route needs an llvm variant")
-    return v
-
-
-def _hemisphere(rng, n, lo=0.05):
-    z = rng.uniform(lo, 1.0, n)
-    ph = rng.uniform(0.0, 2.0 * math.pi, n)
-    s = np.sqrt(1.0 - z * z)
-    # rounded to float32 first: the traced BSDF sees float32 directions
-    return np.stack([s * np.cos(ph), s * np.sin(ph), z], -1).astype(np.float32).astype(float)
+    return variant(name, llvm=True)
 
 
 def _si(view):

@@ -26,10 +26,10 @@ from __future__ import annotations
 
 import gc
 import math
-import warnings
 
 import numpy as np
 import pytest
+from traced_helpers import mirror_pairs
 
 import brdfkit
 from brdfkit._dual import formula, muladd
@@ -61,21 +61,9 @@ def _model(name: str, merl_file):
 
 def _pairs(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """(light, view) float32-exact unit vectors above the horizon, half of the lights near
-    the view's mirror direction (the specular peaks)."""
-    rng = np.random.default_rng(seed)
-
-    def hemi():
-        z = rng.uniform(0.05, 1.0, n)
-        ph = rng.uniform(0.0, 2.0 * math.pi, n)
-        s = np.sqrt(1.0 - z * z)
-        return np.stack([s * np.cos(ph), s * np.sin(ph), z], -1)
-
-    view, light = hemi(), hemi()
-    light[: n // 2] = view[: n // 2] * [-1.0, -1.0, 1.0] + rng.normal(scale=0.1, size=(n // 2, 3))
-    light[:, 2] = np.abs(light[:, 2]) + 0.02
-    light /= np.linalg.norm(light, axis=-1, keepdims=True)
-    return light.astype(np.float32).astype(float), view.astype(np.float32).astype(float)
-
+    the view's mirror direction (the specular peaks): traced_helpers.mirror_pairs."""
+    view, light = mirror_pairs(np.random.default_rng(seed), n)
+    return light, view
 
 def _angles(light, view):
     """(θ_h, θ_d, φ_d) by Rusinkiewicz's rotations in NumPy (independent of the formulas)."""
@@ -135,17 +123,14 @@ def test_numba_formula_equals_model_eval(name, merl_file):
 mi = pytest.importorskip("mitsuba")
 dr = pytest.importorskip("drjit")
 
-from brdfkit.render.mitsuba_bridge import mitsuba_bsdf, use_variant, wavefront  # noqa: E402
+from traced_helpers import variant  # noqa: E402
+
+from brdfkit.render.mitsuba_bridge import mitsuba_bsdf, wavefront  # noqa: E402
 from brdfkit.render.mitsuba_sphere import sphere_scene  # noqa: E402
 
 
 def _llvm(name: str = "llvm_ad_rgb") -> str:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        variant = use_variant(name)
-    if not variant.startswith("llvm"):
-        pytest.skip(f"the traced route needs an llvm variant ({name} fell back to {variant})")
-    return variant
+    return variant(name, llvm=True)
 
 
 @pytest.mark.parametrize("name", SURROGATES + TABLES)

@@ -127,3 +127,33 @@ def test_bad_index(bad):
         fresnel_conductor(0.5, 1.5, -0.1)
     with pytest.raises(ValueError, match="f0"):
         fresnel_schlick(0.5, 1.5)
+
+
+def test_one_dielectric_formula_serves_every_kernel():
+    # Review finding: nielsen, torrance-sparrow/cook-torrance and the ABC surrogate each
+    # carried a copy of the dielectric formula. Every formula with a dielectric Fresnel now
+    # calls brdfkit.fresnel's, and no other registered formula has its code (a copy under
+    # any name compiles to the same bytecode and constants).
+    from brdfkit import _dual, fresnel
+    from brdfkit.data import surrogate_formulas
+    from brdfkit.models import grazing, vgroove
+
+    one = fresnel._fresnel_dielectric_py
+    for kernel in (grazing.nielsen, vgroove.torrance_sparrow, vgroove.cook_torrance,
+                   surrogate_formulas.abc_formula):
+        assert kernel.py_func.__globals__["fresnel_dielectric"] is fresnel._fresnel_dielectric
+    copies = [f"{f.__module__}.{f.__qualname__}" for f in _dual._FORMULAS
+              if f is not one and f.__code__.co_code == one.__code__.co_code
+              and f.__code__.co_consts == one.__code__.co_consts]
+    assert not copies, copies
+
+
+@pytest.mark.parametrize("eta", [0.67, *ETAS])
+def test_dielectric_formula_per_value_is_the_closed_form(eta):
+    # the scalar formula the kernels inline (compiled alone), total internal reflection
+    # (η < 1) included, against the Snell amplitudes of the module docstring
+    from brdfkit.fresnel import _fresnel_dielectric
+
+    cos_i = np.linspace(0.0, 1.0, 41)
+    got = np.array([_fresnel_dielectric(c, eta) for c in cos_i])
+    np.testing.assert_allclose(got, snell_reflectance(cos_i, eta), rtol=1e-12, atol=1e-14)

@@ -49,10 +49,12 @@ from brdfkit.user.proxy_sampler import ProxyStrategy, proxy_formulas
 mi = pytest.importorskip("mitsuba")
 dr = pytest.importorskip("drjit")
 
+from traced_helpers import float32_hemisphere as _hemisphere  # noqa: E402
+from traced_helpers import variant as _variant  # noqa: E402
+
 from brdfkit.render.mitsuba_bridge import (  # noqa: E402
     WavefrontRouteWarning,
     mitsuba_bsdf,
-    use_variant,
     wavefront,
 )
 from brdfkit.render.mitsuba_sphere import sphere_scene  # noqa: E402
@@ -118,20 +120,6 @@ ROOTS = [pytest.param("microfacet-beckmann", "controlled", 1, id="beckmann-contr
          pytest.param("microfacet-ggx-rgb", "max", 1, id="ggx-rgb-max"),
          pytest.param("user-phong", "max", 2, id="user-phong-max-x2")]
 ROOTS += [pytest.param(p.values[0], "max", 1, id=p.id) for p in _registered_with_formulas()]
-
-
-def _variant(name: str) -> str:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return use_variant(name)
-
-
-def _hemisphere(rng, n: int, lo: float = 0.05) -> np.ndarray:
-    z = rng.uniform(lo, 1.0, n)
-    ph = rng.uniform(0.0, 2.0 * math.pi, n)
-    s = np.sqrt(1.0 - z * z)
-    # rounded to float32 first: the traced BSDF sees float32 directions
-    return np.stack([s * np.cos(ph), s * np.sin(ph), z], -1).astype(np.float32).astype(float)
 
 
 def _interaction(view: np.ndarray):

@@ -48,7 +48,6 @@ from __future__ import annotations
 import gc
 import json
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -62,6 +61,9 @@ from brdfkit.pumping import pump
 mi = pytest.importorskip("mitsuba")
 dr = pytest.importorskip("drjit")
 
+from traced_helpers import float32_hemisphere as _hemisphere  # noqa: E402
+from traced_helpers import variant as _variant  # noqa: E402
+
 from brdfkit.render.mitsuba_bridge import (  # noqa: E402
     WavefrontRouteWarning,
     mitsuba_bsdf,
@@ -74,13 +76,6 @@ from brdfkit.render.mitsuba_sphere import render_sphere_mitsuba, sphere_scene  #
 ALPHA_FAMILY = 1e-3
 SUB = 8  # sub-pixel midpoints per axis of the area-averaged reference
 BLOCK = 4  # pixels per side of the blocks the t-tests sum over
-
-
-def _variant(name: str) -> str:
-    """The variant, or its scalar fallback (the warning is the library's, tested below)."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return use_variant(name)
 
 
 def _budget(variant: str) -> tuple[int, int, int]:
@@ -526,14 +521,6 @@ def _interaction(view: np.ndarray, wavelengths: np.ndarray | None = None):
     if wavelengths is not None:
         si.wavelengths = mi.Spectrum(wavelengths.T.astype(np.float32))
     return si
-
-
-def _hemisphere(rng, n: int, lo: float = 0.05) -> np.ndarray:
-    z = rng.uniform(lo, 1.0, n)
-    ph = rng.uniform(0.0, 2.0 * math.pi, n)
-    s = np.sqrt(1.0 - z * z)
-    # rounded to float32 first: the traced BSDF sees float32 directions
-    return np.stack([s * np.cos(ph), s * np.sin(ph), z], -1).astype(np.float32).astype(float)
 
 
 def test_traced_microfacet_against_roughconductor_and_numba():

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import gc
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -20,22 +19,11 @@ import brdfkit
 mi = pytest.importorskip("mitsuba")
 dr = pytest.importorskip("drjit")
 
-from brdfkit.render.mitsuba_bridge import mitsuba_bsdf, use_variant  # noqa: E402
+from traced_helpers import float32_hemisphere as _hemisphere  # noqa: E402
+from traced_helpers import variant as _variant  # noqa: E402
+
+from brdfkit.render.mitsuba_bridge import mitsuba_bsdf  # noqa: E402
 from brdfkit.render.mitsuba_sphere import render_sphere_mitsuba_passes  # noqa: E402
-
-
-def _variant(name: str) -> str:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return use_variant(name)
-
-
-def _hemisphere(rng, n: int, lo: float = 0.05) -> np.ndarray:
-    z = rng.uniform(lo, 1.0, n)
-    ph = rng.uniform(0.0, 2.0 * math.pi, n)
-    s = np.sqrt(1.0 - z * z)
-    # rounded to float32 first: the traced BSDF sees float32 directions
-    return np.stack([s * np.cos(ph), s * np.sin(ph), z], -1).astype(np.float32).astype(float)
 
 
 @pytest.mark.parametrize("name,params", [

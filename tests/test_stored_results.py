@@ -106,8 +106,14 @@ def test_check_of_a_material_reads_its_albedo_from_disk(store_dir, monkeypatch):
 
 
 def test_ambient_table_of_a_material_is_kept_on_disk(store_dir, monkeypatch):
+    # brdfkit.model gives every caller the same catalogue object, whose ambient tables live
+    # in memory with it: a table an earlier test in this process built for it (the CLI's
+    # render sphere --ambient of tests/test_cli_progress.py) was returned without reaching
+    # this test's store, and the second call found nothing on disk (the flaky failure)
     m = brdfkit.model("merl:nickel@abc")
+    clear_caches("brdfkit.render.ambient")
     t1 = ambient.ambient_table(m, theta_max=1.2, tol=1e-4)
+    assert len(list(store_dir.glob("*.npz"))) == 1
     clear_caches("brdfkit.render.ambient")
 
     def no_build(*args):
@@ -144,3 +150,21 @@ def test_render_of_nbrdf_material_with_ambient_light(nickel):
     c = (np.arange(8) + 0.5) / 8 * 2 - 1  # pixel centres; (3, 3) is inside, not on the rim
     theta_v = np.arccos(np.sqrt(1 - c[3] ** 2 - c[3] ** 2))
     np.testing.assert_allclose(r.radiance[3, 3], 0.5 * t(theta_v), atol=2e-3)
+
+
+def test_source_stamp_is_one_per_process_and_survives_clearing(tmp_path, monkeypatch):
+    # the stored results and the drivers' generated modules are keyed on one stamp, which
+    # clearing the caches does not recompute: a source file written meanwhile (here: one
+    # more .py in the package, as a concurrent writer would) must not change the key of a
+    # result between its store and its read in the same process
+    from brdfkit import _cache
+    from brdfkit.models import _drivers
+
+    stamp = _cache.source_stamp()
+    key = stored.result_key("albedo", brdfkit.model("lambert"), THETA)
+    monkeypatch.setattr(_cache, "_scan_sources", lambda: "changed files")
+    clear_caches()
+    assert _cache.source_stamp() == stamp
+    assert stored.result_key("albedo", brdfkit.model("lambert"), THETA) == key
+    assert _drivers.source_stamp is _cache.source_stamp
+    assert stored.source_stamp is _cache.source_stamp

@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import gc
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -230,32 +229,15 @@ def test_proxy_sampler_chi2_diffuse_and_power():
 mi = pytest.importorskip("mitsuba")
 dr = pytest.importorskip("drjit")
 
-from brdfkit.render.mitsuba_bridge import mitsuba_bsdf, use_variant, wavefront  # noqa: E402
+from traced_helpers import mirror_pairs as _directions  # noqa: E402
+from traced_helpers import variant  # noqa: E402
+
+from brdfkit.render.mitsuba_bridge import mitsuba_bsdf, wavefront  # noqa: E402
 from brdfkit.render.mitsuba_sphere import sphere_scene  # noqa: E402
 
 
 def _llvm(name: str) -> str:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        variant = use_variant(name)
-    if not variant.startswith("llvm"):
-        pytest.skip(f"the traced route needs an llvm variant ({name} fell back to {variant})")
-    return variant
-
-
-def _directions(rng, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """(view, light) unit vectors in float32, half the lights near the mirror of the view."""
-    def hemi(lo=0.05):
-        z = rng.uniform(lo, 1.0, n)
-        ph = rng.uniform(0.0, 2.0 * math.pi, n)
-        s = np.sqrt(1.0 - z * z)
-        return np.stack([s * np.cos(ph), s * np.sin(ph), z], -1)
-
-    view, light = hemi(), hemi()
-    light[: n // 2] = view[: n // 2] * [-1.0, -1.0, 1.0] + rng.normal(scale=0.1, size=(n // 2, 3))
-    light[:, 2] = np.abs(light[:, 2]) + 0.02
-    light /= np.linalg.norm(light, axis=-1, keepdims=True)
-    return (view.astype(np.float32).astype(float), light.astype(np.float32).astype(float))
+    return variant(name, llvm=True)
 
 
 def _si(view):

@@ -31,10 +31,15 @@ or :func:`bounded_cache` (a dict-like object), and follows one policy:
 What is not a cache, and so not made here: registries filled once at import
 (models, formulas, primitives, figures), and per-object lazily computed
 attributes derived from the object's own immutable state (a model's lobe
-width, a measured table's interleaved copy), which die with the object.
+width, a measured table's interleaved copy), which die with the object; and
+:func:`source_stamp`, a constant of the process (clearing it would not cost time
+but change keys).
 Caches on disk (Numba's, :mod:`brdfkit.models._drivers`' generated modules, the
-results of ``brdfkit reproduce``) are a different mechanism, keyed on a stamp of the
-sources; brdfkit's own live under :func:`disk_cache_dir`.
+results of ``brdfkit reproduce``, a material's results in :mod:`brdfkit.analysis.stored`)
+are a different mechanism, keyed on a stamp of the sources; brdfkit's own live under
+:func:`disk_cache_dir`, and the drivers' modules and the stored results share one stamp,
+:func:`source_stamp` (computed once per process: the code a process runs is the code it
+imported, whatever is written to the package's files meanwhile).
 
 Thread safety: insertions, evictions and clearing hold a lock; reads rely on
 the atomicity of dict operations under the GIL (the hit and miss counters are
@@ -51,12 +56,15 @@ Public objects
 - :func:`clear_caches`, :func:`cache_info` — every cache at once.
 - :data:`CACHES` — the registry: name → cache.
 - :func:`disk_cache_dir` — the directory of one of brdfkit's caches on disk.
+- :func:`source_stamp` — the stamp of brdfkit's sources that keys those caches.
 """
 
 from __future__ import annotations
 
 import functools
+import hashlib
 import os
+import sys
 import threading
 import weakref
 from collections import OrderedDict
@@ -67,7 +75,7 @@ from pathlib import Path
 from brdfkit.errors import ParameterError
 
 __all__ = ["CACHES", "BoundedCache", "CacheInfo", "bounded_cache", "cache_info",
-           "clear_caches", "memo", "disk_cache_dir"]
+           "clear_caches", "memo", "disk_cache_dir", "source_stamp"]
 
 #: Every named cache, by name (module-level caches: they live as long as the process).
 CACHES: dict[str, BoundedCache] = {}
@@ -286,3 +294,41 @@ def disk_cache_dir(name: str) -> Path:
         xdg = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
         root = os.path.join(xdg, "brdfkit")
     return Path(root) / name
+
+
+#: Hex digits of :func:`source_stamp` kept: 64 bits, no accidental collision between two
+#: versions of the sources on one machine.
+STAMP_HEX = 16
+
+
+def _scan_sources() -> str:
+    import numba  # here, not at import: the cache policy itself needs no compiler
+
+    package = Path(__file__).resolve().parent
+    h = hashlib.sha256(f"{sys.version}|{numba.__version__}|{package}".encode())
+    for path in sorted(package.rglob("*.py")):
+        st = path.stat()
+        h.update(f"{path.relative_to(package)}|{st.st_size}|{st.st_mtime_ns}\n".encode())
+    return h.hexdigest()[:STAMP_HEX]
+
+
+_STAMP: list[str] = []  # the one value of this process (a constant, not a cache: never cleared)
+_STAMP_LOCK = threading.Lock()
+
+
+def source_stamp() -> str:
+    """Stamp of brdfkit's sources: SHA-256 of every ``.py`` file of the package (relative
+    path, size, modification time), its directory and Python's and Numba's versions.
+
+    Computed once per process, at the first call, and never recomputed: it describes the
+    code this process imported, so a key made with it names the code that computed the
+    result. It is not a cache (:func:`clear_caches` does not reset it), for a recomputed
+    stamp would key a result of the old code by the new files (the code in memory does
+    not change with them), and a result stored before the clearing would be missed by a
+    read after it. A changed source changes the stamp of the next process.
+    """
+    if not _STAMP:
+        with _STAMP_LOCK:
+            if not _STAMP:
+                _STAMP.append(_scan_sources())
+    return _STAMP[0]

@@ -6,10 +6,11 @@ Free functions of the cosine of the angle between the incident direction and
 the (micro)surface normal, used by the models the way the papers write them.
 Each exists twice from one source: a scalar ``@njit`` function (prefix ``_``)
 that model kernels call, and a NumPy ufunc compiled from the same Python
-source for the public API. Arguments broadcast. The conductor reflectance is
-also a formula of :mod:`brdfkit._dual` (selects only, names such as ``sqrt``
-instead of ``math.sqrt``), so the Mitsuba bridge traces the same code with
-Dr.Jit.
+source for the public API. Arguments broadcast. The dielectric and conductor
+reflectances are formulas of :mod:`brdfkit._dual` (selects only, names such as
+``sqrt`` instead of ``math.sqrt``), so the Mitsuba bridge traces the same code
+with Dr.Jit; the models' kernels call these (``_fresnel_dielectric``,
+``_fresnel_conductor``), never a copy.
 
 Public objects
 --------------
@@ -48,19 +49,19 @@ __all__ = ["fresnel_dielectric", "fresnel_conductor", "fresnel_schlick", "f0_fro
 
 
 def _fresnel_dielectric_py(c: float, eta: float) -> float:
-    # c is a cosine; clamp to [0, 1] because the callers pass dot products of
-    # unit vectors, which rounding can push just outside that range.
-    c = min(max(c, 0.0), 1.0)
+    # Cook & Torrance's F in g and c (Lewis §3.2). A formula (brdfkit._dual), the one every
+    # kernel with a dielectric Fresnel calls (nielsen, torrance-sparrow, cook-torrance, the
+    # ABC surrogate): total internal reflection is a select, so that it vectorises inside
+    # the compiled kernels and Dr.Jit can trace it.
+    c = minimum(maximum(c, 0.0), 1.0)  # clamp: a cosine of unit vectors (rounding)
     g2 = eta * eta + c * c - 1.0
-    if g2 <= 0.0:
-        # Total internal reflection (possible only for eta < 1).
-        return 1.0
-    g = math.sqrt(g2)
+    tir = g2 <= 0.0  # total internal reflection (possible only for eta < 1): F = 1
+    g = sqrt(select(tir, 1.0, g2))  # 1.0: the discarded lane stays finite
     gpc = g + c
     gmc = g - c
     a = c * gpc - 1.0
     b = c * gmc + 1.0
-    return 0.5 * (gmc * gmc) / (gpc * gpc) * (1.0 + (a * a) / (b * b))
+    return select(tir, 1.0, 0.5 * (gmc * gmc) / (gpc * gpc) * (1.0 + (a * a) / (b * b)))
 
 
 TINY = 5e-324  # the smallest positive float64, a divisor floor of _fresnel_conductor_py
@@ -112,7 +113,7 @@ def _fresnel_schlick_py(c: float, f0: float) -> float:
 
 
 # Scalar kernels for model code (inlined into the compiled model kernels).
-_fresnel_dielectric = numba.njit(cache=True, inline="always")(_fresnel_dielectric_py)
+_fresnel_dielectric = formula(_fresnel_dielectric_py)  # Numba; Dr.Jit: _dual.drjit_version
 _fresnel_conductor = formula(_fresnel_conductor_py)  # Numba; Dr.Jit: _dual.drjit_version
 _fresnel_schlick = numba.njit(cache=True, inline="always")(_fresnel_schlick_py)
 

@@ -8,8 +8,9 @@ channel and value, and the verdict's tolerance needs millions of values). They d
 nothing but the model's numbers, the request (angles, tolerance) and brdfkit's code, so
 they are computed once and kept under :func:`brdfkit._cache.disk_cache_dir` ``("results")``.
 
-- **key**: SHA-256 of the code stamp (every ``.py`` file of the package: path, size,
-  mtime — a changed engine never reads an older result), the model's class, name,
+- **key**: SHA-256 of the code stamp (:func:`brdfkit._cache.source_stamp`, once per
+  process: every ``.py`` file of the package by path, size, mtime — a changed engine
+  never reads an older result), the model's class, name,
   ``to_dict()``, symmetry flags and packed numbers (a measured table's values, a net's
   weights), and the request's numbers (arrays by their bytes).
 - **what is kept**: only models that represent data (``model.provenance()`` non-empty:
@@ -40,7 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from brdfkit import _io
-from brdfkit._cache import disk_cache_dir, memo
+from brdfkit._cache import disk_cache_dir, source_stamp
 from brdfkit.errors import BrdfkitError
 
 __all__ = ["result_key", "load", "store", "keeps", "stored_albedo", "MAX_ENTRIES"]
@@ -54,16 +55,6 @@ def _root() -> Path:
     return disk_cache_dir("results")
 
 
-@memo(maxsize=1)  # once per process: the package does not change under a running command
-def _code_stamp() -> str:
-    package = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256()
-    for path in sorted(package.rglob("*.py")):
-        st = path.stat()
-        h.update(f"{path.relative_to(package)}|{st.st_size}|{st.st_mtime_ns}\n".encode())
-    return h.hexdigest()[:16]
-
-
 def keeps(model) -> bool:
     """Results are kept for a model representing data (``provenance()`` non-empty)."""
     return bool(model.provenance())
@@ -71,7 +62,7 @@ def keeps(model) -> bool:
 
 def result_key(kind: str, model, *request) -> str:
     """SHA-256 (32 hex digits) of the code stamp, *kind*, the model and the *request*."""
-    h = hashlib.sha256(f"{_code_stamp()}|{kind}|{type(model).__qualname__}|{model.name}|"
+    h = hashlib.sha256(f"{source_stamp()}|{kind}|{type(model).__qualname__}|{model.name}|"
                        f"{model.to_dict()!r}|{model.isotropic}|{model.mirror_symmetric}|"
                        f"{model.reciprocal}".encode())
     h.update(np.ascontiguousarray(np.asarray(model.packed, dtype=np.float64)).tobytes())

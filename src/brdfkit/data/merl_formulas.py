@@ -26,7 +26,7 @@ the neighbouring bin: ``nearest`` then reads the neighbour's value (the lookup
 is discontinuous there), ``linear`` differs by rounding only.
 
 Sampler: the cosine + GGX proxy of the table's lobe
-(:mod:`brdfkit.user.proxy_sampler`), as for the surrogates
+(:mod:`brdfkit.models.proxy_sampler`), as for the surrogates
 (:mod:`brdfkit.data.surrogate_formulas`).
 
 Public objects
@@ -45,6 +45,7 @@ from __future__ import annotations
 import math
 
 from brdfkit._dual import Formulas, acos, atan2, floor, formula, maximum, minimum, select, sqrt
+from brdfkit.models.proxy_sampler import proxy_args, proxy_pdf, proxy_sample
 from brdfkit.tables import row_at
 
 __all__ = ["measured_formulas", "merl_angles", "merl_nearest", "merl_linear"]
@@ -136,8 +137,6 @@ def merl_linear(ix, iy, iz, ox, oy, oz, p):
 def measured_formulas(model) -> Formulas:
     """*model*'s (a MeasuredBRDF's) formulas: its lookup (module docstring), the cosine +
     GGX proxy of its lobe as sampler and pdf; the table from column TABLE on."""
-    from brdfkit.user.proxy_sampler import proxy_args, proxy_pdf, proxy_sample
-
     f = merl_linear if model.values["lookup"] == "linear" else merl_nearest
     return Formulas(eval=f, sample=proxy_sample, pdf=proxy_pdf, args=proxy_args(model),
                     tables=TABLE)

@@ -29,7 +29,7 @@ largest component: equal to rounding), the cosines clamped to [0, 1] before
 
 Samplers: these materials' own samplers are tabulated (:mod:`brdfkit.data.sampler`),
 not formulas. Their traced sampler is the cosine + GGX proxy of
-:mod:`brdfkit.user.proxy_sampler` fitted to the material's lobe (its pdf is the
+:mod:`brdfkit.models.proxy_sampler` fitted to the material's lobe (its pdf is the
 density of its samples: Monte-Carlo estimates stay unbiased; only the variance
 differs from the tabulated sampler's).
 
@@ -39,7 +39,8 @@ Public objects
   formulas (``SurrogateBRDF.formulas``).
 - :func:`abc_formula`, :func:`sgd_formula`, :func:`npf_formula` — the kernels as formulas.
 - :func:`nbrdf_formula` — the generated NBRDF formula.
-- :func:`half_unit`, :func:`fresnel_dielectric` — shared formulas.
+- :func:`half_unit` — a shared formula (the dielectric Fresnel is
+  :mod:`brdfkit.fresnel`'s formula).
 """
 
 from __future__ import annotations
@@ -60,10 +61,12 @@ from brdfkit._dual import (
     sqrt,
 )
 from brdfkit._kern import SMALL_LENGTH
+from brdfkit.fresnel import _fresnel_dielectric as fresnel_dielectric
+from brdfkit.models.proxy_sampler import proxy_args, proxy_pdf, proxy_sample
 from brdfkit.tables import row_at
 
 __all__ = ["surrogate_formulas", "abc_formula", "sgd_formula", "npf_formula", "nbrdf_formula",
-           "half_unit", "fresnel_dielectric"]
+           "half_unit"]
 
 INV_PI = 1.0 / math.pi
 HALF_PI = 0.5 * math.pi
@@ -86,21 +89,6 @@ def half_unit(ix, iy, iz, ox, oy, oz):
     sx, sy, sz = sx * r, sy * r, sz * r
     length = sqrt(sx * sx + sy * sy + sz * sz)
     return sx / length, sy / length, sz / length
-
-
-@formula
-def fresnel_dielectric(c, eta):
-    """Unpolarised dielectric Fresnel reflectance (:func:`brdfkit.fresnel._fresnel_dielectric`,
-    its branch a select): 1 under total internal reflection."""
-    c = minimum(maximum(c, 0.0), 1.0)  # a cosine of unit vectors: clamp rounding
-    g2 = eta * eta + c * c - 1.0
-    tir = g2 <= 0.0
-    g = sqrt(select(tir, 1.0, g2))  # 1.0: the discarded lane stays finite
-    gpc = g + c
-    gmc = g - c
-    a = c * gpc - 1.0
-    b = c * gmc + 1.0
-    return select(tir, 1.0, 0.5 * (gmc * gmc) / (gpc * gpc) * (1.0 + (a * a) / (b * b)))
 
 
 # --------------------------------------------------------------------------- ABC
@@ -268,8 +256,6 @@ _ANALYTIC = {"abc": abc_formula, "sgd": sgd_formula}
 def surrogate_formulas(model):
     """*model*'s (a SurrogateBRDF's) Formulas: its f_r as a formula (module docstring), the
     cosine + GGX proxy of its lobe as sampler and pdf."""
-    from brdfkit.user.proxy_sampler import proxy_args, proxy_pdf, proxy_sample
-
     rep = model.representation
     args = proxy_args(model)
     if rep == "npf":

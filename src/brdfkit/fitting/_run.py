@@ -356,8 +356,9 @@ class FitRun:
         n0 = self.n_evals()
         before = prob.loss_at(self.values)
         budget = max(self.settings.max_evals, 100 * len(shape))
-        steps = self.space.steps(self.values, shape)
         starts, always = shape_starts(self)
+        # at the guess (moved off a bound by shape_starts: the steps there, not at the bound)
+        steps = self.space.steps(starts[0][1], shape)
         best = None
         agree = 0
         for label, v0 in starts:

@@ -49,7 +49,11 @@ Stages of ``procedure="staged"`` (= ``"auto"``, any model):
     optional parameter declared None keeps its value); ``n_starts − 2``
     random ones (z of the guess plus N(0, 1), from
     ``numpy.random.default_rng(seed)``) — ``n_starts`` starts in all besides the
-    nested one, the bound starts first after the guess. Every run is
+    nested one, the bound starts first after the guess. A shape parameter whose
+    start sits at a bound of its range (a conductor's κ at its default 0: its
+    coordinate saturated, the simplex cannot move it) is first moved off it
+    (``_starts.off_the_bounds``: the guess at the best z of a scan, the bounds
+    included; the defaults at the best interior local minimum). Every run is
     recorded; once two runs reach the same loss (relative difference ≤
     :data:`CONSENSUS`) the remaining starts (but bound starts) are recorded
     as skipped. ``procedure="nielsen"`` compares the runs with their linear

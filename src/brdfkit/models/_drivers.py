@@ -51,9 +51,10 @@ names as globals: the same code, so the same values as a closure over them).
 
 Staleness. Numba invalidates a cache entry when *its own* source file changes,
 not when a function it calls changes. The generated file's directory is
-therefore named after a stamp of every source file of the brdfkit package
-(path, size, modification time), Numba's and Python's versions: any edit to
-brdfkit gives new files, and the old directories are pruned after a week.
+therefore named after :func:`brdfkit._cache.source_stamp` (every source file of
+the brdfkit package: path, size, modification time; Numba's and Python's
+versions): any edit to brdfkit gives new files in the next process, and the old
+directories are pruned after a week.
 
 Where. ``$BRDFKIT_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/brdfkit`` (default
 ``~/.cache/brdfkit``), subdirectory ``drivers``. When the directory cannot be
@@ -82,7 +83,7 @@ import numba
 import numpy as np
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
-from brdfkit._cache import bounded_cache, disk_cache_dir, memo
+from brdfkit._cache import bounded_cache, disk_cache_dir, memo, source_stamp
 from brdfkit._kern import load_input, store_output
 from brdfkit._threads import numba_threads  # noqa: F401  (re-exported)
 
@@ -400,17 +401,6 @@ def cache_dir() -> Path:
     return disk_cache_dir("drivers")
 
 
-@memo(maxsize=1)  # once per process
-def _source_stamp() -> str:
-    """Hash of every brdfkit source file's (path, size, mtime) and the tool versions."""
-    package = Path(__file__).resolve().parents[1]
-    h = hashlib.sha256(f"{sys.version}|{numba.__version__}|{package}".encode())
-    for path in sorted(package.rglob("*.py")):
-        st = path.stat()
-        h.update(f"{path.relative_to(package)}|{st.st_size}|{st.st_mtime_ns}\n".encode())
-    return h.hexdigest()[:16]
-
-
 def _resolve(module: str, qualname: str):
     obj = importlib.import_module(module)
     for part in qualname.split("."):
@@ -450,7 +440,7 @@ def _prune(parent: Path, keep: str) -> None:
 def _load(source: str):
     """The generated module of *source*, written once per source stamp; None when the
     cache directory cannot be written or Numba finds no place for its cache."""
-    stamp = _source_stamp()
+    stamp = source_stamp()
     key = hashlib.sha256(source.encode()).hexdigest()[:12]
     name = f"_brdfkit_driver_{stamp}_{key}"
     if name in sys.modules:

@@ -62,7 +62,16 @@ class _Traced:
 
 
 class _CosPowerTraced(_Traced):
-    """:class:`_Traced` sampled by ``CosPowerNormal(q)`` (``_cos_power_q``), as formulas."""
+    """:class:`_Traced` sampled by ``CosPowerNormal(q)`` (``_cos_power_q``), as formulas;
+    reciprocal (f depends on N·S and N·V symmetrically) and its width parameter from a
+    half-angle β by the class's ``_width_of_beta`` (a :mod:`brdfkit.halfangle` function)."""
+
+    reciprocal = True
+    has_sampler = True
+
+    @classmethod
+    def width_from_beta(cls, beta: float) -> float:
+        return cls._width_of_beta(beta)
 
     def _strategy(self, wo):
         return CosPowerNormal(self._cos_power_q())
@@ -163,19 +172,15 @@ class NeumannNeumann(_CosPowerTraced, StrategySampled, BRDF):
     summary = "Neumann-Neumann lacquer: b_N exp{-s(1/N.S + 1/N.V - 2)}"
     params = NEUMANN_NEUMANN_PARAMS
     citation = "Lewis 1993 §3.3 (after Neumann & Neumann 1989)"
-    reciprocal = True
-    has_sampler = True
     width_param = "s"
     kernel = _neumann_neumann
+    _width_of_beta = staticmethod(neumann_s_from_beta)
     examples = (
         {},
         {"b_N": 1.0, "s": 50.0},
         {"b_N": [0.1, 0.2, 0.3], "s": 0.05},
     )
 
-    @classmethod
-    def width_from_beta(cls, beta: float) -> float:
-        return neumann_s_from_beta(beta)
 
     def lobes(self):
         s = float(self._values["s"])
@@ -270,19 +275,15 @@ class Minnaert(_CosPowerTraced, StrategySampled, BRDF):
     summary = "Minnaert: b_M ((N.S)(N.V))^(k-1)"
     params = MINNAERT_PARAMS
     citation = "Lewis 1993 §3.4 (after Minnaert 1941)"
-    reciprocal = True
-    has_sampler = True
     width_param = "k"
     kernel = _minnaert
+    _width_of_beta = staticmethod(minnaert_k_from_beta)
     examples = (
         {},
         {"b_M": 1.0, "k": 200.0},
         {"b_M": [0.1, 0.2, 0.3], "k": 0.7},
     )
 
-    @classmethod
-    def width_from_beta(cls, beta: float) -> float:
-        return minnaert_k_from_beta(beta)
 
     def lobes(self):
         return _minnaert_lobes(float(self._values["k"]))
@@ -323,10 +324,9 @@ class MinnaertEnergyConserving(_CosPowerTraced, StrategySampled, BRDF):
     summary = "energy-normalised Minnaert: k_rho (k+1)/2pi ((N.S)(N.V))^(k-1)"
     params = MINNAERT_EC_PARAMS
     citation = "Lewis 1993 §4.3"
-    reciprocal = True
-    has_sampler = True
     width_param = "k"
     kernel = _minnaert_ec
+    _width_of_beta = staticmethod(minnaert_k_from_beta)
     examples = (
         {},
         {"k_rho": 1.0, "k": 200.0},
@@ -334,9 +334,6 @@ class MinnaertEnergyConserving(_CosPowerTraced, StrategySampled, BRDF):
         {"k_rho": 0.5, "k": 0.5},
     )
 
-    @classmethod
-    def width_from_beta(cls, beta: float) -> float:
-        return minnaert_k_from_beta(beta)
 
     def lobes(self):
         return _minnaert_lobes(float(self._values["k"]))

@@ -31,8 +31,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from brdfkit._dual import formula, maximum, minimum, select, sqrt
+from brdfkit._dual import formula, maximum, select
 from brdfkit._kern import INV_PI, INV_TWO_PI
+from brdfkit.fresnel import _fresnel_dielectric as fresnel_dielectric
 from brdfkit.models._base import VECTOR_OPTIONS, Lobe, Param
 from brdfkit.models._lobes import (
     COS_DIVISOR_FLOOR,
@@ -165,22 +166,6 @@ NIELSEN_PARAMS = (
 )
 N_RHO_D, N_K_S, N_S, N_ALPHA, N_ETA = packed_indices(
     NIELSEN_PARAMS, "rho_d", "k_s", "s", "alpha", "eta")
-
-
-@formula
-def fresnel_dielectric(c, eta):
-    """:func:`brdfkit.fresnel.fresnel_dielectric` (its operations) as a branch-free formula:
-    c clamped to [0, 1] (callers pass dot products of unit vectors, which rounding can push
-    just outside), 1 for total internal reflection (g² ≤ 0, only for η < 1)."""
-    c = minimum(maximum(c, 0.0), 1.0)
-    g2 = eta * eta + c * c - 1.0
-    tir = g2 <= 0.0
-    g = sqrt(select(tir, 1.0, g2))  # 1.0: the discarded lane finite
-    gpc = g + c
-    gmc = g - c
-    a = c * gpc - 1.0
-    b = c * gmc + 1.0
-    return select(tir, 1.0, 0.5 * (gmc * gmc) / (gpc * gpc) * (1.0 + (a * a) / (b * b)))
 
 
 @formula

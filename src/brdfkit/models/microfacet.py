@@ -202,17 +202,27 @@ def _walter_ggx_f(ix, iy, iz, ox, oy, oz, p):
 # packed rows as one flat tuple (t[c·N_PACKED + k]): walter_terms once, then each channel as
 # walter computes it (the same operations: bit-equal to the per-channel kernels).
 N_PACKED = len(PARAMS)
+if (P_ETA, P_K, P_SCALE) != (N_PACKED - 3, N_PACKED - 2, N_PACKED - 1):  # walter_channels
+    raise RuntimeError("microfacet: eta, k, rho_s must end the packed row (walter_channels)")
+
+
+@numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
+def walter_channels(live, c, v, t, fresnel):  # pragma: no cover - compiled
+    """(f_R, f_G, f_B): :func:`walter_channel` of each row of the flat tuple *t* of three
+    rows whose last three entries are η, κ and the scale (the rows of ``microfacet`` and
+    ``microfacet-anisotropic``; row length len(t)/3, a constant of the tuple's type that
+    LLVM folds into the indices)."""
+    n = len(t) // 3
+    return (walter_channel(live, c, v, t[n - 3], t[n - 2], t[n - 1], fresnel),
+            walter_channel(live, c, v, t[2 * n - 3], t[2 * n - 2], t[2 * n - 1], fresnel),
+            walter_channel(live, c, v, t[3 * n - 3], t[3 * n - 2], t[3 * n - 1], fresnel))
 
 
 @numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
 def walter_rgb(ix, iy, iz, ox, oy, oz, t, ggx, fresnel):  # pragma: no cover - compiled
     """(f_R, f_G, f_B) of :func:`walter` over the flat tuple *t* of the three rows."""
     live, c, v = walter_terms(ix, iy, iz, ox, oy, oz, t[P_ALPHA], ggx)
-    return (walter_channel(live, c, v, t[P_ETA], t[P_K], t[P_SCALE], fresnel),
-            walter_channel(live, c, v, t[N_PACKED + P_ETA], t[N_PACKED + P_K],
-                           t[N_PACKED + P_SCALE], fresnel),
-            walter_channel(live, c, v, t[2 * N_PACKED + P_ETA], t[2 * N_PACKED + P_K],
-                           t[2 * N_PACKED + P_SCALE], fresnel))
+    return walter_channels(live, c, v, t, fresnel)
 
 
 @numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)

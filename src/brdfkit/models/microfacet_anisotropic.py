@@ -74,6 +74,7 @@ from brdfkit.models.microfacet import (
     half_sum,
     reflection_jacobian,
     walter_channel,
+    walter_channels,
 )
 from brdfkit.models.microfacet_distributions import (
     _beckmann_g1_over_cos_r,
@@ -174,17 +175,16 @@ _KERNELS = {(False, False): _beckmann, (False, True): _beckmann_f, (True, False)
 # packed rows as one flat tuple (t[c·N_PACKED + k]): the terms once, then each channel as
 # walter_anisotropic computes it (the same operations: bit-equal to the per-channel kernels).
 N_PACKED = len(PARAMS)
+if (P_ETA, P_K, P_SCALE) != (N_PACKED - 3, N_PACKED - 2, N_PACKED - 1):  # walter_channels
+    raise RuntimeError("microfacet-anisotropic: eta, k, rho_s must end the packed row "
+                      "(walter_channels)")
 
 
 @numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)
 def walter_anisotropic_rgb(ix, iy, iz, ox, oy, oz, t, ggx, fresnel):  # pragma: no cover
     """(f_R, f_G, f_B) of :func:`walter_anisotropic` over the flat tuple *t* of the rows."""
     live, c, v = walter_anisotropic_terms(ix, iy, iz, ox, oy, oz, t[P_AX], t[P_AY], ggx)
-    return (walter_channel(live, c, v, t[P_ETA], t[P_K], t[P_SCALE], fresnel),
-            walter_channel(live, c, v, t[N_PACKED + P_ETA], t[N_PACKED + P_K],
-                           t[N_PACKED + P_SCALE], fresnel),
-            walter_channel(live, c, v, t[2 * N_PACKED + P_ETA], t[2 * N_PACKED + P_K],
-                           t[2 * N_PACKED + P_SCALE], fresnel))
+    return walter_channels(live, c, v, t, fresnel)
 
 
 @numba.njit(cache=True, inline="always", **VECTOR_OPTIONS)

@@ -37,6 +37,7 @@ from brdfkit._dual import (
     sqrt,
 )
 from brdfkit.errors import ParameterError
+from brdfkit.fresnel import _fresnel_dielectric as fresnel_dielectric
 from brdfkit.halfangle import (
     beckmann_m_from_beta,
     beta_from_beckmann_m,
@@ -403,22 +404,6 @@ _TWO_600 = 2.0 ** 600  # the exact rescaling of a short s = wi + wo (half_sum)
 #: tan²δ/m² beyond which e^{−tan²δ/m²} < 1e-290 is given as 0 (as beckmann_lobe)
 EXPONENT_FLOOR = -700.0
 FOUR_PI = 4.0 * math.pi
-
-
-@formula
-def fresnel_dielectric(c, eta):
-    """The dielectric Fresnel reflectance of :func:`brdfkit.fresnel.fresnel_dielectric`
-    (Cook & Torrance 1982 eq. in g, c) as a formula: the same operations, its total internal
-    reflection branch (g² ≤ 0, η < 1) a select."""
-    c = minimum(maximum(c, 0.0), 1.0)  # clamp: a cosine of unit vectors (rounding)
-    g2 = eta * eta + c * c - 1.0
-    tir = g2 <= 0.0
-    g = sqrt(select(tir, 1.0, g2))  # 1: the discarded lane finite
-    gpc = g + c
-    gmc = g - c
-    a = c * gpc - 1.0
-    b = c * gmc + 1.0
-    return select(tir, 1.0, 0.5 * (gmc * gmc) / (gpc * gpc) * (1.0 + (a * a) / (b * b)))
 
 
 @formula

@@ -50,6 +50,7 @@ from brdfkit.data.sampler import TabulatedSampler
 from brdfkit.errors import ParameterError
 from brdfkit.models import DerivedBRDF, Lobe
 from brdfkit.models._drivers import UNIT_TOL, loop_driver
+from brdfkit.models.proxy_sampler import proxy_formulas
 from brdfkit.user._loops import sampler_loops
 
 __all__ = ["ModelDefinition", "SamplerFormulas", "FormulaBRDF", "measure_isotropy",
@@ -456,13 +457,12 @@ class FormulaBRDF(TabulatedSampler, DerivedBRDF):
 
     def formulas(self) -> Formulas:
         """The kernel, and the user's sampler and pdf, or else a cosine + GGX proxy sampler
-        fitted to this model's lobe (:func:`brdfkit.user.proxy_sampler.proxy_formulas`):
+        fitted to this model's lobe (:func:`brdfkit.models.proxy_sampler.proxy_formulas`):
         the Mitsuba bridge traces them."""
         d = self._definition
         if d.sampler is not None:
             return Formulas(eval=d.kernel, sample=d.sampler.sample, pdf=d.sampler.pdf,
                             args=tuple(float(a) for a in d.sampler.args(self.values)))
-        from brdfkit.user.proxy_sampler import proxy_formulas
         return proxy_formulas(self)
 
     # ------------------------------------------------------------ rebuild, describe
