@@ -56,9 +56,9 @@ PAGE_MODEL = "modified-phong"
 #: A quarter of the 100-ms budget of a slider move, which the other views (~10-30 ms), the
 #: transfer and the drawing share.
 DRAFT_ABOVE_S = 0.025
-#: Angles of the draft albedo curve (every 6 degrees from 0 to 89.5): a(θ_i) is smooth
-#: between its declared kinks, and the plot joins the points.
-DRAFT_ALBEDO_ANGLES = 16
+#: Angles of the draft albedo curve (every 10 degrees from 0 to 89.5; the cost of the
+#: curve is per angle): a(θ_i) is smooth between its declared kinks, the plot joins them.
+DRAFT_ALBEDO_ANGLES = 10
 #: Accuracy of the draft albedo curve: a third of a pixel of the 0-1 plot, ~300 px high.
 DRAFT_ALBEDO_TOL = 1e-3
 #: Pixels across the draft sphere: about the 150 CSS pixels the page shows it at.
