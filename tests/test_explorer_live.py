@@ -29,7 +29,7 @@ import urllib.parse
 
 import numpy as np
 import pytest
-from explorer_harness import TEST_BUDGET_S, free_port, open_page, wait_answering
+from explorer_harness import TEST_BUDGET_S, free_port, open_page, wait_answering, wait_ready
 
 import brdfkit
 from brdfkit.data.export import export_merl
@@ -355,7 +355,9 @@ def test_page_reloads_a_saved_file(browser, server, tmp_path):
     # on an idle machine, not here: CI shares 2 cores with the rest of the suite.
     assert max(latencies) <= FROZEN_S, latencies
     assert "reloaded" in page.locator("#model-file-0").text_content()
-    # a broken edit: its error at the model's place, the last good drawing stays
+    # a broken edit: its error at the model's place, the last good drawing stays (the
+    # exact one: a slow model's save is drawn as a draft first, then exact, then "ready")
+    wait_ready(page)
     src_good = page.locator("#spheres img").first.get_attribute("src")
     p.write_bytes(b"not a MERL table")
     page.wait_for_function("document.getElementById('model-error-0').textContent"
