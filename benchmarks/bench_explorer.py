@@ -7,7 +7,14 @@ TestClient, so the JSON encoding, the HTTP layer and the worker process are incl
 browser's drawing not), per model, for the two kinds of slider:
 
 - a **parameter** slider (a new model: every view, including the 90-angle albedo curve
-  and the θ_h × θ_d image, is recomputed);
+  and the θ_h × θ_d image, is recomputed), as the page asks it: ``"draft": true`` — a
+  slow model's slow parts come as drafts (``brdfkit.explorer.compute``, "Drafts") — and
+  then, when the answer held a draft, the same state with ``"draft": false`` (the exact
+  views): the columns ``param move`` (what the page draws first: the target) and
+  ``exact`` (the draft's request plus the exact one, until the page is final), with
+  ``draft`` saying whether the model's moves were drafted; ``no drafts`` is the same move
+  asked with ``"draft": false`` (the page before drafts: every view exact at once; the
+  baseline, timed in the same run) and ``ratio`` = param move / no drafts;
 - a **direction/light** slider (θ_i or Φ_L: the model-only views come from the cache).
 
 The models: every registered model (:data:`brdfkit.models.MODELS`, its first parameter
@@ -22,9 +29,13 @@ slowest is visible.
 from __future__ import annotations
 
 import argparse
+import os
+import statistics
+import time
 import warnings
 
 from _timing import median_time
+from bench_explorer_edit import _lscpu_model
 
 from brdfkit.explorer import views
 from brdfkit.explorer.compute import build_entry
@@ -66,26 +77,45 @@ def _median_ms(f, repeats):
 
 
 def bench_one(client, entry, moved, n):
-    """Medians (ms): a parameter move (None without a parameter) and an angle move."""
+    """Medians (ms): a parameter move as the page draws it first and until exact (None
+    without a parameter), whether it was drafted, and an angle move."""
     counter = {"k": 0}
     m = build_entry(entry)
     base = m.to_dict()["params"].get(moved) if moved else None
+    first, drafted = [], []
 
-    def post(e, theta_i):
-        r = client.post("/api/views", json={"models": [e], "theta_i": theta_i, "phi_l": 30})
+    def post(e, theta_i, draft=True) -> bool:
+        r = client.post("/api/views", json={"models": [e], "theta_i": theta_i, "phi_l": 30,
+                                            "draft": draft})
         assert r.status_code == 200 and "error" not in r.json()["models"][0], r.text[:500]
+        return r.json()["models"][0]["draft"]
 
     def param_move():  # a new parameter value each time: nothing cached
         counter["k"] += 1
         v = base * (1.0 - STEP * counter["k"]) if base else STEP * counter["k"]
-        post({**entry, "params": {**entry["params"], moved: v}}, 30)
+        e = {**entry, "params": {**entry["params"], moved: v}}
+        t0 = time.perf_counter()
+        was_draft = post(e, 30)
+        first.append(time.perf_counter() - t0)
+        drafted.append(was_draft)
+        if was_draft:  # the page asks again for the exact views
+            assert post(e, 30, draft=False) is False
+
+    def old_move():  # as the page asked before drafts: every view exact at once
+        counter["k"] += 1
+        v = base * (1.0 - STEP * counter["k"]) if base else STEP * counter["k"]
+        post({**entry, "params": {**entry["params"], moved: v}}, 30, draft=False)
 
     def angle_move():
         counter["k"] += 1
         post(entry, 10 + counter["k"] % 60)
 
-    t_param = _median_ms(param_move, n) if moved else None
-    return t_param, _median_ms(angle_move, n), m
+    t_old = _median_ms(old_move, n) if moved else None
+    t_exact = _median_ms(param_move, n) if moved else None
+    first, drafted = first[1:], drafted[1:]  # without the warm-up call
+    t_first = 1e3 * statistics.median(first) if moved else None
+    return (t_first, t_exact, t_old, (any(drafted) if moved else None),
+            _median_ms(angle_move, n), m)
 
 
 def view_parts(m, n):
@@ -101,12 +131,14 @@ def main() -> None:
     ap.add_argument("--views", action="store_true", help="time each view too")
     ap.add_argument("--only", nargs="*", help="these models only")
     a = ap.parse_args()
+    print("load average (1, 5, 15 min) before: {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         from fastapi.testclient import TestClient
 
         from brdfkit.explorer.app import create_app
-    print(f"{'model':28s} {'param move':>10s} {'angle move':>10s}" +
+    print(f"{'model':28s} {'param move':>10s} {'exact':>8s} {'draft':>5s} "
+          f"{'no drafts':>9s} {'ratio':>5s} {'angle move':>10s}" +
           ("  | polar  curves  lobe  sphere  halfdiff  albedo" if a.views else "") +
           f"  (ms, median of {a.repeats})")
     worst = 0.0
@@ -114,16 +146,23 @@ def main() -> None:
         for label, entry, moved in entries():
             if a.only and label not in a.only:
                 continue
-            t_param, t_angle, m = bench_one(client, entry, moved, a.repeats)
+            t_param, t_exact, t_old, drafted, t_angle, m = bench_one(client, entry, moved,
+                                                                     a.repeats)
             worst = max(worst, t_param or 0.0, t_angle)
             what = f"{label} ({moved})" if moved else label
             line = (f"{what:28s} {'-' if t_param is None else f'{t_param:.1f}':>10s} "
+                    f"{'-' if t_exact is None else f'{t_exact:.1f}':>8s} "
+                    f"{'-' if drafted is None else ('yes' if drafted else 'no'):>5s} "
+                    f"{'-' if t_old is None else f'{t_old:.1f}':>9s} "
+                    f"{'-' if t_old is None else f'{t_param / t_old:.2f}':>5s} "
                     f"{t_angle:10.1f}")
             if a.views:
                 line += "  | " + "  ".join(f"{x:5.1f}" for x in view_parts(m, a.repeats))
             print(line, flush=True)
-    print(f"\nslowest: {worst:.1f} ms; target: <= {TARGET_MS:.0f} ms per slider move "
-          "(issues 12, 23)")
+    print(f"\nslowest: {worst:.1f} ms (param move as first drawn, angle move); target: <= "
+          f"{TARGET_MS:.0f} ms per slider move (issues 12, 23)")
+    print(f"cpu: {_lscpu_model()}; load average (1, 5, 15 min) after: "
+          "{:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
 
 
 if __name__ == "__main__":

@@ -132,6 +132,10 @@ def test_page_loads_and_updates(browser, server, tmp_path):
     wait_ready(page)
     albedo1 = page.evaluate("drawnData('albedo')")
     assert albedo1 != albedo0  # the albedo curve moved with n
+    # "ready" once the views are exact (a slow model's move is drawn as a draft first,
+    # then asked again without: tests/test_explorer_draft.py)
+    assert page.evaluate("lastViews.models.every(v => v.draft === false && "
+                         "v.albedo.theta_deg.length === 90)")
     # the state is in the URL: a new page at that URL restores n = 200
     shared = page.url
     assert "200" in urllib.parse.unquote(shared)

@@ -29,7 +29,7 @@ import urllib.parse
 
 import numpy as np
 import pytest
-from explorer_harness import TEST_BUDGET_S, free_port, open_page, wait_answering
+from explorer_harness import TEST_BUDGET_S, free_port, open_page, wait_answering, wait_ready
 
 import brdfkit
 from brdfkit.data.export import export_merl
@@ -355,7 +355,9 @@ def test_page_reloads_a_saved_file(browser, server, tmp_path):
     # on an idle machine, not here: CI shares 2 cores with the rest of the suite.
     assert max(latencies) <= FROZEN_S, latencies
     assert "reloaded" in page.locator("#model-file-0").text_content()
-    # a broken edit: its error at the model's place, the last good drawing stays
+    # a broken edit: its error at the model's place, the last good drawing stays (the
+    # exact one: a slow model's save is drawn as a draft first, then exact, then "ready")
+    wait_ready(page)
     src_good = page.locator("#spheres img").first.get_attribute("src")
     p.write_bytes(b"not a MERL table")
     page.wait_for_function("document.getElementById('model-error-0').textContent"
@@ -461,14 +463,17 @@ def test_page_python_file_opened_by_path_and_live(browser, server, tmp_path):
     page.fill("#open-path", str(py))
     page.click("#open-button")
     _wait_value(page, 1, 0.5 / math.pi, 60_000)
+    wait_ready(page)  # idle (a slow model's exact views follow its draft): one save timed
     t0 = time.perf_counter()
     py.write_text(LAMBERT_PY.format(scale=1.0, name="rho").replace('"rho", 0.5', '"rho", 0.9'))
     _wait_value(page, 1, 0.9 / math.pi, 60_000)
     # the .py loader compiles a file's formulas on every load (a new content: a new module);
-    # the explorer draws the interpreted draft meanwhile (3.9-7.4 s before it; 0.24 s now)
+    # the explorer draws the interpreted draft meanwhile (3.9-7.4 s before it)
     latency = time.perf_counter() - t0
     print(f".py reload (a default edit): {latency:.2f} s")
-    assert latency <= 3.0, latency  # one save on a shared machine; best of 3 ≤ 1 s below
+    # drawn, not frozen; its speed (a .py save drawn by the draft within 1 s) is measured by
+    # benchmarks/bench_explorer_edit.py: a timed bound fails on a loaded CI machine
+    assert latency <= FROZEN_S, latency
     assert errors == []
     page.close()
 

@@ -20,7 +20,9 @@ page works offline) and a JSON API:
 
 A state is ``{"models": [{"spec", "params", "pump", "times", "visible"}],
 "theta_i", "phi_i", "phi_l" (Φ_L of the sphere test, 0–180), "ambient" (angles
-in degrees, as on the command line), "mode": "luminance"|"rgb", "cosine": bool}``.
+in degrees, as on the command line), "mode": "luminance"|"rgb", "cosine": bool,
+"draft": bool}`` (``draft`` true: a slow part of a model's views may be a draft, and the
+model's answer says ``"draft": true``; :mod:`brdfkit.explorer.compute`, "Drafts").
 A model that cannot be built (unknown spec, parameter out of bounds, unreadable file) comes back as
 ``{"spec", "error"}`` and the page shows the message; the other models are
 drawn. Models are cached by their full description (a pumped model's tables
@@ -142,6 +144,9 @@ def parse_state(state: dict) -> dict:
         "ambient": _number(state, "ambient", 0.0, 0.0, 10.0),
         "mode": mode,
         "cosine": bool(state.get("cosine", False)),
+        # slow parts may come as drafts, marked "draft" (compute.py, "Drafts"); the page's
+        # slider moves ask so, then ask again without
+        "draft": state.get("draft", False) is True,
     }
 
 

@@ -16,6 +16,7 @@ import base64
 import json
 import math
 import tempfile
+import time
 from pathlib import Path
 
 from brdfkit._cache import bounded_cache
@@ -39,6 +40,31 @@ PAGE_STATE = {"theta_i": math.radians(30.0), "phi_i": 0.0, "phi_l": math.radians
               "ambient": 0.0, "mode": "luminance", "cosine": False}
 #: The page's first model when no spec is given (``defaultState()`` in static/app.js).
 PAGE_MODEL = "modified-phong"
+
+# Drafts (issue 23: a slider move drawn within 100 ms). A request with ``"draft": true``
+# (the page's) may get a slow part of a model's views as a draft, marked ``"draft": true``
+# in the model's answer; the page then asks again with ``"draft": false`` and draws the
+# exact views. A part is drafted when the exact one of the same *family* (the spec, its
+# operators and, for a file, its stage: a slider move changes only the parameters) took
+# longer than DRAFT_ABOVE_S the last time it was computed (so a fast model is never
+# drafted, and a slow one is on every move of its sliders). The parts:
+#: - a pumped model: built on coarser tables (:func:`brdfkit.pumping.draft.draft_pump`,
+#:   within :data:`~brdfkit.pumping.draft.DRAFT_REL_TOL` of the exact model);
+#: - the albedo curve: DRAFT_ALBEDO_ANGLES angles to DRAFT_ALBEDO_TOL (the exact: 90 to
+#:   :data:`~brdfkit.explorer.views.ALBEDO_TOL`);
+#: - the lit sphere: DRAFT_SPHERE_SIZE pixels across (the exact: 256), the same renderer.
+#: A quarter of the 100-ms budget of a slider move, which the other views (~10-30 ms), the
+#: transfer and the drawing share.
+DRAFT_ABOVE_S = 0.025
+#: Angles of the draft albedo curve (every 10 degrees from 0 to 89.5; the cost of the
+#: curve is per angle): a(θ_i) is smooth between its declared kinks, the plot joins them.
+DRAFT_ALBEDO_ANGLES = 10
+#: Accuracy of the draft albedo curve: a third of a pixel of the 0-1 plot, ~300 px high.
+DRAFT_ALBEDO_TOL = 1e-3
+#: Pixels across the draft sphere: about the 150 CSS pixels the page shows it at.
+DRAFT_SPHERE_SIZE = 128
+#: Families whose costs are remembered (LRU): a page shows a few models at a time.
+_COSTS_SIZE = 256
 
 
 def start_payload(specs=()) -> dict:
@@ -119,6 +145,8 @@ class Session:
 
     def __init__(self, *, mark=None):
         self.cache = bounded_cache(None, maxsize=_CACHE_SIZE)
+        # family|part -> seconds of its last exact computation (module comment, "Drafts")
+        self.costs = bounded_cache(None, maxsize=_COSTS_SIZE)
         self._digests: dict[str, str | None] = {}
         watcher = _Marks(self, mark)
         self.files = files.FileModels(warm=warm, watcher=watcher)
@@ -134,8 +162,15 @@ class Session:
 
     @staticmethod
     def _key(entry: dict) -> str:
-        return json.dumps({k: entry.get(k) for k in ("spec", "params", "pump", "times")},
-                          sort_keys=True)
+        return json.dumps({k: entry.get(k) for k in ("spec", "params", "pump", "times",
+                                                     "compensate")}, sort_keys=True)
+
+    @staticmethod
+    def _family(entry: dict, info: dict | None = None) -> str:
+        """The key of an entry without its parameters (module comment, "Drafts")."""
+        return json.dumps({k: entry.get(k) for k in ("spec", "pump", "times", "compensate")},
+                          sort_keys=True) + ("|interpreted" if (info or {}).get("compiled")
+                                             is False else "")
 
     def _cached(self, key, make):
         got = self.cache.get(key)
@@ -143,12 +178,45 @@ class Session:
             got = self.cache[key] = make()
         return got
 
-    def get_built(self, entry: dict) -> tuple:
-        """``(model, info)``: *info* empty for a model not from a file (app docstring)."""
+    def _slow(self, family: str, part: str) -> bool:
+        """The exact *part* of this family took longer than DRAFT_ABOVE_S the last time."""
+        return self.costs.get(family + "|" + part, 0.0) > DRAFT_ABOVE_S
+
+    def _exact_or_draft(self, key: str, family: str, part: str, draft: bool, exact, rough):
+        """``(value, drafted)``: the cached exact value, else the draft *rough()* when
+        *draft* and this part is slow in its family, else *exact()* (timed: the family's
+        cost). Drafts are cached under their own key."""
+        got = self.cache.get(key)
+        if got is not None:
+            return got, False
+        if draft and self._slow(family, part):
+            return self._cached(key + "|draft", rough), True
+        t0 = time.perf_counter()
+        got = self.cache[key] = exact()
+        self.costs[family + "|" + part] = time.perf_counter() - t0
+        return got, False
+
+    def get_built(self, entry: dict, *, draft: bool = False) -> tuple:
+        """``(model, info)``: *info* empty for a model not from a file (app docstring), and
+        ``{"draft": True}`` for a pumped model's draft (*draft* allowed: module comment,
+        "Drafts")."""
         page_params(entry)
         path = files.spec_file(entry["spec"])
         if path is None:
-            m, info = self._cached(self._key(entry), lambda: (build_entry(entry), {}))
+            def rough():  # the same spec unpumped, then pumped on the draft's tables
+                from brdfkit.pumping.draft import draft_pump
+
+                spec = entry_spec(entry)
+                *inner, last = spec.operators
+                if last.kind != "pump":  # compensated after pumping: no draft of that
+                    return build_entry(entry), {}
+                args = last.arguments
+                root = ModelSpec(spec.target, spec.params, inner).build()
+                return draft_pump(root, args["g"], times=args["times"]), {"draft": True}
+
+            (m, info), _ = self._exact_or_draft(
+                self._key(entry), self._family(entry), "build",
+                draft and bool(entry.get("pump")), lambda: (build_entry(entry), {}), rough)
         else:
             digest = (self._digests[path] if path in self._digests
                       else files.content_digest(path))
@@ -160,47 +228,63 @@ class Session:
         _check_channels(m)
         return m, info
 
-    def model_only(self, entry: dict, m, info: dict, mode: str, phi_i: float) -> dict:
+    @staticmethod
+    def _model_key(entry: dict, info: dict) -> str:
+        """The cache key of one built model: the entry, its file's content and stage."""
+        return (Session._key(entry) + "|" + info.get("digest", "")
+                + ("" if info.get("compiled", True) else "|interpreted")
+                + ("|draft" if info.get("draft") else ""))
+
+    def model_only(self, entry: dict, m, info: dict, mode: str, phi_i: float,
+                   draft: bool = False) -> tuple[dict, bool]:
         """Views that depend on the model alone (not on the direction or the light):
         computed once per model and channel mode, so moving θ_i, φ_i or Φ_L skips them
-        (an anisotropic model's albedo curve is at φ_i: computed once per φ_i)."""
+        (an anisotropic model's albedo curve is at φ_i: computed once per φ_i); and whether
+        the albedo curve is a draft (module comment, "Drafts")."""
         phi = 0.0 if m.isotropic else phi_i
+        key = self._model_key(entry, info) + "|" + mode + ("" if m.isotropic else f"|{phi!r}")
 
-        def make():
+        def halfdiff():
             png_h, hd = views.halfdiff(m)
-            return {"albedo": views.albedo_curve(m, mode=mode, phi=phi),
-                    "halfdiff": _b64(png_h), "halfdiff_info": hd}
-        return self._cached(self._key(entry) + "|" + info.get("digest", "") + "|views|" + mode
-                            + ("" if info.get("compiled", True) else "|interpreted")
-                            + ("" if m.isotropic else f"|{phi!r}"), make)
+            return {"halfdiff": _b64(png_h), "halfdiff_info": hd}
+        curve, drafted = self._exact_or_draft(
+            key + "|albedo", self._family(entry, info), "albedo", draft,
+            lambda: views.albedo_curve(m, mode=mode, phi=phi),
+            lambda: views.albedo_curve(m, mode=mode, phi=phi, n=DRAFT_ALBEDO_ANGLES,
+                                       tol=DRAFT_ALBEDO_TOL))
+        return {"albedo": curve, **self._cached(key + "|halfdiff", halfdiff)}, drafted
 
-    def lit_sphere(self, entry: dict, m, info: dict, s: dict) -> tuple:
-        """The sphere view ``(PNG as a data URL, info)``: it depends on the model and the
-        light (Φ_L, ambient) alone, so a θ_i or φ_i move takes it from the cache."""
-        def make():
-            png, sph = views.sphere(m, phi_l=s["phi_l"], ambient=s["ambient"])
+    def lit_sphere(self, entry: dict, m, info: dict, s: dict, draft: bool = False) -> tuple:
+        """The sphere view ``(PNG as a data URL, info, drafted)``: it depends on the model
+        and the light (Φ_L, ambient) alone, so a θ_i or φ_i move takes it from the cache."""
+        def make(size=256):
+            png, sph = views.sphere(m, phi_l=s["phi_l"], ambient=s["ambient"], size=size)
             return _b64(png), sph
-        return self._cached(self._key(entry) + "|" + info.get("digest", "") + "|sphere|"
-                            + ("" if info.get("compiled", True) else "|interpreted")
-                            + f"|{float(s['phi_l'])!r}|{float(s['ambient'])!r}", make)
+        (png, sph), drafted = self._exact_or_draft(
+            self._model_key(entry, info) + f"|sphere|{float(s['phi_l'])!r}|"
+            f"{float(s['ambient'])!r}", self._family(entry, info), "sphere", draft, make,
+            lambda: make(DRAFT_SPHERE_SIZE))
+        return png, sph, drafted
 
     def model_views(self, entry: dict, s: dict) -> JSONText | dict:
         """Every view of one entry for the state *s* (:func:`app.parse_state`) as JSON
         text, or ``{"spec", "error"}``."""
         try:
-            m, info = self.get_built(entry)
-            png_s, sph = self.lit_sphere(entry, m, info, s)
+            draft = bool(s.get("draft", False))
+            m, info = self.get_built(entry, draft=draft)
+            png_s, sph, rough_sphere = self.lit_sphere(entry, m, info, s, draft)
+            only, rough_albedo = self.model_only(entry, m, info, s["mode"], s["phi_i"], draft)
+            drafted = bool(info.get("draft")) or rough_sphere or rough_albedo
             return JSONText(json_text({
                 **to_jsonable({**info, "spec": entry.get("spec"), "name": m.name,
-                               "params": m.to_dict()["params"]}),
+                               "params": m.to_dict()["params"], "draft": drafted}),
                 "polar": views.polar(m, s["theta_i"], s["phi_i"], cosine=s["cosine"],
                                      mode=s["mode"]),
                 "lobe": views.lobe(m, s["theta_i"], s["phi_i"]),
                 "curves": views.curves(m, s["theta_i"], s["phi_i"], cosine=s["cosine"],
                                        mode=s["mode"]),
                 "sphere": png_s, "sphere_info": sph,
-                "reciprocal_claim": m.reciprocal,
-                **self.model_only(entry, m, info, s["mode"], s["phi_i"]),
+                "reciprocal_claim": m.reciprocal, **only,
             }))
         except BrdfkitError as exc:
             return error_entry(entry, str(exc))

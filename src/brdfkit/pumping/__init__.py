@@ -28,6 +28,8 @@ Modules
   stand-in for a one-times pumped model that a fit evaluates (basis albedo tables per
   shape-parameter node, linear parameters combined; ``docs/pumping.md``, "Fitting a pumped
   model").
+- :mod:`brdfkit.pumping.draft` — :func:`~brdfkit.pumping.draft.draft_pump`, the same
+  stages on coarser tables (within 0.5 %): what the explorer draws while a slider moves.
 - :mod:`brdfkit.tables` (shared with the models) — the grid variable and the
   compiled :class:`~brdfkit.tables.Lookup` the kernels read.
 

@@ -125,7 +125,8 @@ class PumpedBRDF(DerivedBRDF):
         """A fit starts from the unpumped root's fit (``BRDF.fit_base``)."""
         return self.root
 
-    def __init__(self, base: BRDF, g: str | Callable = "max"):
+    def __init__(self, base: BRDF, g: str | Callable = "max", *, table=None):
+        # table: the base's AlbedoTable when built otherwise (a draft's: brdfkit.pumping.draft)
         self.base = base
         self.root = base.root if isinstance(base, PumpedBRDF) else base
         self.g = g if isinstance(g, str) else "custom"
@@ -133,7 +134,7 @@ class PumpedBRDF(DerivedBRDF):
         self.stages = (base.stages if isinstance(base, PumpedBRDF) else []) + [self.g]
         self.depth = len(self.stages)
         self._n_rows = base.packed.shape[0]  # 1, or the number of channels
-        self.table = build_albedo_table(base)
+        self.table = build_albedo_table(base) if table is None else table
         self.capped = bool(np.all(self.table.max_albedo - self.table.max_midpoint_error
                                   <= 1.0 + ENGINE_ERR))
         if not self.capped:

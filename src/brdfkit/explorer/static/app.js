@@ -381,9 +381,13 @@ function request() {
   return { body: Object.assign({}, state, { models: vis.map(([m]) => m) }), index: vis.map(([, i]) => i) };
 }
 
+// Each state is asked with draft: true (the server may answer a slow model's slow views
+// as drafts, marked draft: true, compute.py "Drafts"), then, when some were drafts and no
+// newer state waits, once more with draft: false: the exact views. "ready" once exact.
 async function update() {
   writeHash();
   pending = request();
+  pending.body.draft = true;
   if (inflight) return;  // the newest state is sent when the running request returns
   while (pending) {
     const req = pending; pending = null; inflight = true;
@@ -399,6 +403,10 @@ async function update() {
         "views " + data.ms + " ms on the server, " + Math.round(performance.now() - t0) +
         " ms round trip, drawn in " + Math.round(drawMs) + " ms" +
         (lobeMs === null ? "" : " (+ 3-D lobe " + Math.round(lobeMs) + " ms)");
+      if (data.models.some(v => v.draft)) {  // drafts drawn: the exact views next
+        if (!pending) pending = { body: Object.assign({}, req.body, { draft: false }), index: req.index };
+        continue;
+      }
       document.getElementById("status").textContent = "ready";
       fetchVerdicts(req);
     } catch (e) {
