@@ -119,6 +119,11 @@ class Formulas:
                   parameters: the traced route holds those columns as one Dr.Jit
                   array and gathers from it, ``docs/architecture.md``, "Tables
                   in the trace")
+    vectorise     True: an engine that composes *eval* into a compiled loop (a
+                  compensation's kernel) composes it into the vectorising loop;
+                  False: it composes the model's kernel instead (an unrolled
+                  network: LLVM's optimiser takes minutes on its ~600 straight-line
+                  operations inside that loop)
     ============  ================================================================
     """
 
@@ -127,6 +132,7 @@ class Formulas:
     pdf: Callable
     args: tuple = ()
     tables: int | None = None
+    vectorise: bool = True
 
 
 def formula(f=None, **options):

@@ -173,9 +173,10 @@ class CompensatedBRDF(DerivedBRDF):
         kernel = driver = None
         if base.kernel is not None:
             # a base whose eval is a formula (branch-free and total: the _dual contract)
-            # composes into the vectorising loop, like its own eval (microfacet's)
+            # composes into the vectorising loop, like its own eval (microfacet's), unless
+            # the formula says it is not for that loop (Formulas.vectorise: an unrolled net)
             formulas = base.formulas()
-            vector = formulas is not None and formulas.eval is not None
+            vector = formulas is not None and formulas.eval is not None and formulas.vectorise
             kernel, driver = spec.kernel(formulas.eval if vector else base.kernel,
                                          base.packed.shape[1], vector=vector,
                                          uniform=table.uniform)
@@ -262,11 +263,12 @@ class CompensatedBRDF(DerivedBRDF):
         k = self.base.packed.shape[1]
         if self.method == "turquin":
             return Formulas(eval=turquin_formula(base.eval, k, uniform=self.table.uniform),
-                            sample=base.sample, pdf=base.pdf, args=base.args, tables=k + 1)
+                            sample=base.sample, pdf=base.pdf, args=base.args, tables=k + 1,
+                            vectorise=base.vectorise)
         sample, pdf = kulla_conty_sampler(base.sample, base.pdf, len(base.args))
         return Formulas(eval=kulla_conty_formula(base.eval, k, uniform=self.table.uniform),
                         sample=sample, pdf=pdf, args=(*self._weight_args(), *base.args),
-                        tables=k + 1)
+                        tables=k + 1, vectorise=base.vectorise)
 
     # ---------------------------------------------------------------- sampling
     def _weight_args(self) -> tuple:

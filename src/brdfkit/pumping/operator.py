@@ -385,7 +385,8 @@ class PumpedBRDF(DerivedBRDF):
         if root is None or self.kernel is None or root.tables is not None:
             return None
         return Formulas(eval=pumped_formula(self, root.eval), sample=root.sample,
-                        pdf=root.pdf, args=root.args, tables=self.root.packed.shape[1])
+                        pdf=root.pdf, args=root.args, tables=self.root.packed.shape[1],
+                        vectorise=root.vectorise)
 
     def sample(self, wo, u):
         """The base model's sampler (the pdf is the base pdf)."""

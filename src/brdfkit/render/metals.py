@@ -309,7 +309,8 @@ class FresnelWeightedBRDF(DerivedBRDF):
             return None
         return Formulas(eval=compose(_fresnel_weighted, base_eval=base.eval),
                         sample=base.sample, pdf=base.pdf, args=base.args,
-                        tables=None if base.tables is None else base.tables + 2)
+                        tables=None if base.tables is None else base.tables + 2,
+                        vectorise=base.vectorise)
 
     def with_params(self, **changes) -> BRDF:
         mine = {key: changes.pop(key) for key in ("eta", "k") if key in changes}
