@@ -119,7 +119,7 @@ mi = pytest.importorskip("mitsuba")
 dr = pytest.importorskip("drjit")
 
 from traced_helpers import float32_hemisphere as _hemisphere  # noqa: E402
-from traced_helpers import variant  # noqa: E402
+from traced_helpers import mitsuba_chi2, variant  # noqa: E402
 
 from brdfkit.render.mitsuba_bridge import mitsuba_bsdf  # noqa: E402
 
@@ -214,14 +214,7 @@ def test_traced_lambert_against_mitsuba_diffuse():
 def test_chi2_traced_sampler(props, wi):
     """Mitsuba's own χ² goodness-of-fit test of the traced sample() against its pdf()."""
     _variant("llvm_ad_rgb")
-    from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
-
     name = props["model"]
     assert mitsuba_bsdf(brdfkit.model(name, **{k: v for k, v in props.items()
                                                if k != "model"})).traced
-    sample_func, pdf_func = BSDFAdapter("brdfkit", {"type": "brdfkit", **props}, wi=wi)
-    chi2 = ChiSquareTest(domain=SphericalDomain(), sample_func=sample_func,
-                         pdf_func=pdf_func, sample_dim=3, res=51, ires=4,
-                         sample_count=200_000)
-    assert chi2.run(), chi2.messages
-    gc.collect()
+    mitsuba_chi2(props, wi)

@@ -32,6 +32,7 @@ import warnings
 
 import numpy as np
 import pytest
+from traced_helpers import mitsuba_chi2
 
 import brdfkit
 
@@ -211,16 +212,9 @@ def test_chi2_traced_sampler(props, wi):
     """Mitsuba's own χ² goodness-of-fit test (mitsuba.chi2, as in test_render_mitsuba.py)
     of the traced sample() against the traced pdf()."""
     _llvm_rgb()
-    from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
-
     params = {k: v for k, v in props.items() if k != "model"}
     assert mitsuba_bsdf(brdfkit.model(props["model"], **params)).traced
-    sample_func, pdf_func = BSDFAdapter("brdfkit", {"type": "brdfkit", **props}, wi=wi)
-    chi2 = ChiSquareTest(domain=SphericalDomain(), sample_func=sample_func,
-                         pdf_func=pdf_func, sample_dim=3, res=51, ires=4,
-                         sample_count=200_000)
-    assert chi2.run(), chi2.messages
-    gc.collect()
+    mitsuba_chi2(props, wi)
 
 
 @pytest.mark.parametrize("name,params,wi", [

@@ -62,6 +62,7 @@ mi = pytest.importorskip("mitsuba")
 dr = pytest.importorskip("drjit")
 
 from traced_helpers import float32_hemisphere as _hemisphere  # noqa: E402
+from traced_helpers import mitsuba_chi2  # noqa: E402
 from traced_helpers import variant as _variant  # noqa: E402
 
 from brdfkit.render.mitsuba_bridge import (  # noqa: E402
@@ -256,14 +257,7 @@ def test_direction_mapping_non_reciprocal():
 def test_chi2_mitsuba_harness(props, wi):
     """Mitsuba's own χ² goodness-of-fit test of the plugin's sample() against its pdf()."""
     _variant("llvm_ad_rgb")
-    from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
-
-    sample_func, pdf_func = BSDFAdapter("brdfkit", {"type": "brdfkit", **props}, wi=wi)
-    chi2 = ChiSquareTest(domain=SphericalDomain(), sample_func=sample_func,
-                         pdf_func=pdf_func, sample_dim=3, res=51, ires=4,
-                         sample_count=200_000)
-    assert chi2.run(), chi2.messages
-    gc.collect()
+    mitsuba_chi2(props, wi)
 
 
 def test_sphere_against_exact_non_reciprocal():
