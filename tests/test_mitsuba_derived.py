@@ -130,9 +130,7 @@ def _interaction(view: np.ndarray):
 
 @pytest.mark.parametrize(("root", "g", "times"), ROOTS)
 def test_pumped_traced_matches_numba_and_samples_the_root(root, g, times):
-    variant = _variant("llvm_ad_rgb")
-    if not variant.startswith("llvm"):
-        pytest.skip("no LLVM: the traced route needs an llvm_* variant")
+    _variant("llvm_ad_rgb", llvm=True)
     base = _root(root)
     model = pump(base, g, times=times)
     assert model.formulas() is not None and model.formulas().tables == base.packed.shape[1]
@@ -175,9 +173,7 @@ def test_compensated_traced_matches_numba(kw, method):
     base's, Kulla–Conty's the mixture of the cosine and the base's sampler (its weight's Ẽ
     a polynomial, in NumPy and in the trace): traced pdf and directions = model.pdf and
     model.sample for the same u. (Kulla–Conty fell back to the wavefront route before.)"""
-    variant = _variant("llvm_ad_rgb")
-    if not variant.startswith("llvm"):
-        pytest.skip("no LLVM")
+    _variant("llvm_ad_rgb", llvm=True)
     base = brdfkit.model("microfacet", **kw)
     model = brdfkit.compensate(base, method)
     ours = mitsuba_bsdf(model)
@@ -302,9 +298,7 @@ def _routes_model(name: str):
 def test_traced_render_equals_the_wavefront_render(name):
     """Same seed, same sampler formula: the two routes render the same image (the
     wavefront route evaluates the float64 Numba kernel)."""
-    variant = _variant("llvm_ad_rgb")
-    if not variant.startswith("llvm"):
-        pytest.skip("no LLVM")
+    variant = _variant("llvm_ad_rgb", llvm=True)
     model = _routes_model(name)
 
     def render(route):
@@ -350,9 +344,7 @@ def test_phong_energy_conserving_traced(kw):
     formulas against model.sample/pdf (the NumPy Mixture of the cosine and the lobe): the
     same directions and densities to float32 rounding; the formula's Numba compilation
     against model.eval (float64)."""
-    variant = _variant("llvm_ad_rgb")
-    if not variant.startswith("llvm"):
-        pytest.skip("no LLVM")
+    _variant("llvm_ad_rgb", llvm=True)
     model = brdfkit.model("phong-energy-conserving", **kw)
     form = model.formulas()
     ours = mitsuba_bsdf(model)
