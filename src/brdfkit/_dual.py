@@ -36,6 +36,7 @@ name            Numba                           Dr.Jit
 select(c,a,b)   ``a if c else b``               ``dr.select``
 sqrt, exp, log  ``math.*``                      ``dr.*``
 log1p           ``math.log1p``                  Goldberg's log(1+x)·x/((1+x)−1)
+expm1           ``math.expm1``                  Kahan's (eˣ−1)·x/log eˣ
 sin, cos, tan,  ``math.*``                      ``dr.*``
 asin, acos,
 atan, atan2
@@ -62,6 +63,8 @@ References
   Compiler for Differentiable Rendering*, ACM TOG 41(4), 2022 (tracing).
 - D. Goldberg, *What every computer scientist should know about floating-point
   arithmetic*, ACM Computing Surveys 23(1), 1991, Theorem 4 (log1p).
+- W. Kahan, as given by N. J. Higham, *Accuracy and Stability of Numerical
+  Algorithms*, 2nd ed., SIAM 2002, §1.14.1 (expm1 as (u − 1)·x/log u, u = eˣ).
 - W. H. Press et al., *Numerical Recipes in C*, 2nd ed., 1992, §6.2, ``erfcc``
   (erfc with fractional error < 1.2e-7 everywhere).
 """
@@ -83,7 +86,7 @@ from brdfkit._kern import exp_nonpos
 __all__ = ["Formulas", "formula", "compose", "primitive", "drjit_version", "select", "sqrt",
            "exp", "log",
            "log1p", "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "power", "floor",
-           "minimum", "maximum", "absolute", "exp_nonpos", "erfc", "muladd",
+           "minimum", "maximum", "absolute", "exp_nonpos", "erfc", "muladd", "expm1",
            "numpy_version"]
 
 _jit = numba.njit(cache=True, inline="always")
@@ -230,6 +233,7 @@ sqrt = math.sqrt
 exp = math.exp
 log = math.log
 log1p = math.log1p
+expm1 = math.expm1
 sin = math.sin
 cos = math.cos
 tan = math.tan
@@ -253,6 +257,18 @@ def _log1p_drjit(dr):
     return log1p_
 
 
+def _expm1_drjit(dr):
+    def expm1_(x):
+        u = dr.exp(x)
+        # Kahan: (u − 1)·x/log u is accurate where u rounds; u = 1: x; u = inf: inf
+        # (x/log u = 1 there: the select keeps inf·1 rather than inf/inf)
+        d = dr.log(u)
+        ok = (u != 1.0) & (d < math.inf)
+        return dr.select(ok, (u - 1.0) * (x / dr.select(ok, d, 1.0)),
+                         dr.select(u == 1.0, x, u - 1.0))
+    return expm1_
+
+
 def _erfc_drjit(dr):
     def erfc_(x):
         z = dr.abs(x)
@@ -269,7 +285,8 @@ for _obj, _factory in (
         (select, lambda dr: dr.select), (minimum, lambda dr: dr.minimum),
         (maximum, lambda dr: dr.maximum), (absolute, lambda dr: dr.abs),
         (sqrt, lambda dr: dr.sqrt), (exp, lambda dr: dr.exp), (log, lambda dr: dr.log),
-        (log1p, _log1p_drjit), (sin, lambda dr: dr.sin), (cos, lambda dr: dr.cos),
+        (log1p, _log1p_drjit), (expm1, _expm1_drjit),
+        (sin, lambda dr: dr.sin), (cos, lambda dr: dr.cos),
         (tan, lambda dr: dr.tan), (asin, lambda dr: dr.asin), (acos, lambda dr: dr.acos),
         (atan, lambda dr: dr.atan), (atan2, lambda dr: dr.atan2),
         (power, lambda dr: dr.power), (floor, lambda dr: dr.floor),
@@ -304,6 +321,7 @@ _NUMPY_PRIMITIVES = {select: np.where, minimum: np.minimum, maximum: np.maximum,
                      absolute: np.abs, power: np.power, floor: np.floor,
                      muladd: lambda a, b, c: a * b + c}
 _NUMPY_BY_NAME = {"sqrt": np.sqrt, "exp": np.exp, "log": np.log, "log1p": np.log1p,
+                  "expm1": np.expm1,
                   "sin": np.sin, "cos": np.cos, "tan": np.tan, "asin": np.arcsin,
                   "acos": np.arccos, "atan": np.arctan, "atan2": np.arctan2,
                   "exp_nonpos": np.exp}  # (erfc: no NumPy version; SciPy's is not imported)

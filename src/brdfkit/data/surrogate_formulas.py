@@ -194,9 +194,8 @@ def nbrdf_features(ix, iy, iz, ox, oy, oz):
 #: The generated NBRDF formula's source: the net of surrogates.nbrdf_kernel unrolled, the
 #: sums in the kernel's order (so the same values), weights by constant index.
 _NBRDF_HEADER = '''"""brdfkit: generated NBRDF formula ({nh} hidden units; surrogate_formulas)."""
-from brdfkit._dual import formula, muladd, select
+from brdfkit._dual import expm1, formula, muladd, select
 from brdfkit.data.surrogate_formulas import nbrdf_features
-from brdfkit.data.table_formulas import expm1
 
 
 @formula(cache={cache}, inline="never")
