@@ -18,7 +18,8 @@ that Numba caches on disk (below).
   branch-free total kernels such as the microfacet models'), ``"rgb"`` (the same, for a
   kernel computing three channels at once from all packed rows), ``"blocked"``
   (locate a block of pairs, then read them: table lookups), ``"albedo"`` (the
-  albedo engine's serial loop over incident angles and outgoing nodes).
+  albedo engine's serial loop over incident angles and outgoing nodes); a higher layer
+  adds its own with :func:`add_loop` (the exact sphere's, :mod:`brdfkit.render.sphere`).
 - :func:`loop_driver` — the loop *loop* for one kernel with an importable name,
   generated as a module and cached on disk (else compiled in memory);
   :func:`blocked_driver` — the blocked loop with its hooks, likewise.
@@ -87,7 +88,7 @@ from brdfkit._cache import bounded_cache, disk_cache_dir, memo, source_stamp
 from brdfkit._kern import load_input, store_output
 from brdfkit._threads import numba_threads  # noqa: F401  (re-exported)
 
-__all__ = ["SERIAL_BELOW", "UNIT_TOL", "VECTOR_OPTIONS", "LOOPS", "eval_pairs",
+__all__ = ["SERIAL_BELOW", "UNIT_TOL", "VECTOR_OPTIONS", "LOOPS", "add_loop", "eval_pairs",
            "eval_pairs_checked", "loop_driver", "blocked_driver", "composed", "generic_loop",
            "checked_driver", "cached_driver", "numba_threads", "cache_dir"]
 
@@ -316,6 +317,14 @@ LOOPS = {
     "blocked": ((("driver", _blocked_loop, 'parallel=True, error_model="numpy"'),), {}),
     "albedo": ((("driver", _albedo_nodes, 'error_model="numpy"'),), {}),
 }
+
+
+def add_loop(loop: str, functions: tuple, constants: dict | None = None) -> None:
+    """Register a loop of a higher layer (render's sphere loop) in :data:`LOOPS`, in the
+    same form, so that :func:`loop_driver` generates and caches it per kernel."""
+    if LOOPS.get(loop, (functions, constants or {})) != (functions, constants or {}):
+        raise ValueError(f"loop {loop!r} is registered already with other functions")
+    LOOPS[loop] = (functions, constants or {})
 
 
 @memo(maxsize=32)  # one entry per (loop, flags): 5 loops × a few flag sets

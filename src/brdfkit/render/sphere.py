@@ -54,6 +54,7 @@ import numpy as np
 from brdfkit._cache import bounded_cache, memo
 from brdfkit.errors import BrdfkitError, ParameterError
 from brdfkit.models import BRDF
+from brdfkit.models._drivers import add_loop, loop_driver
 from brdfkit.render.ambient import RHO_TOL, ambient_table
 from brdfkit.render.silhouette import (
     DEFAULT_ANTIALIAS,
@@ -233,10 +234,10 @@ def _lit_pixels(size, lx, ly, lz, wi, wo, index, cos_l):  # pragma: no cover - c
     return k
 
 
-# Not cached on disk: a specialisation is keyed on the kernel's dispatcher, new in every
-# process (as brdfkit.models.eval_pairs). Serial for the reason above; it also writes the
-# image directly, with no arrays of directions in between.
-@numba.njit
+# The loop template of the "sphere" loop (models._drivers.add_loop, below): generated per
+# kernel and cached on disk, as the models' own loops (compiled in every process, it cost
+# 0.35-0.6 s of every first sphere: the explorer's first views, `render sphere`). Serial for
+# the reason above; it writes the image directly, with no arrays of directions in between.
 def _direct(kernel, size, lx, ly, lz, P, E, out):  # pragma: no cover - compiled
     """out[r·S + c, ch] += E·kernel(wi, wo, P[ch])·(N·L) at the lit disc pixels (frames as
     in :func:`_lit_pixels`); other rows of *out* are left as they are."""
@@ -253,6 +254,9 @@ def _direct(kernel, size, lx, ly, lz, P, E, out):  # pragma: no cover - compiled
             w = E * n_dot_l
             for ch in range(P.shape[0]):
                 out[r * size + c, ch] += w * kernel(ix, iy, n_dot_l, ox, oy, z, P[ch])
+
+
+add_loop("sphere", (("_pixel", _pixel, 'inline="always"'), ("driver", _direct, "")))
 
 
 @numba.njit(cache=True)
@@ -486,7 +490,7 @@ def render_sphere(model: BRDF, *, phi_l: float, light_azimuth: float = 0.0,
         out = np.zeros((S * S, C))
     if E > 0.0 and model.kernel is not None:
         P = np.ascontiguousarray(np.asarray(model.packed, dtype=np.float64))
-        _direct(model.kernel, S, L[0], L[1], L[2], P, E, out)
+        loop_driver(model.kernel, loop="sphere")(S, L[0], L[1], L[2], P, E, out)
     elif E > 0.0:  # a model evaluated in NumPy (kernel None): directions, then model.eval
         M = S * S
         wi, wo = np.empty((M, 3)), np.empty((M, 3))
