@@ -7,8 +7,9 @@ second of
 - ``model.eval`` now: the branch-free formula kernel (``brdfkit._dual``) in the
   ``"vector"`` loop (``lobe_power`` multiplies for an integral exponent);
 - the former kernel, copied below as it was (``if below_horizon: return 0.0``,
-  ``lobe_pow``'s loop, ``n_dot_h``'s branch), in the ``"checked"`` loop that
-  ``BRDF.eval`` ran for it (the baseline);
+  ``lobe_pow``'s loop, ``n_dot_h``'s branch; for ``lafortune`` and ``nh-power-series``
+  the class's kernel, a loop over the lobes, which model.eval ran until issue 23), in the
+  ``"checked"`` loop that ``BRDF.eval`` ran for it (the baseline);
 
 and the ratio new/former, after checking that both give the same values
 (bit-equal is expected: the formulas repeat the former operations). The machine's
@@ -73,7 +74,13 @@ def former_nielsen_no_eta(ix, iy, iz, ox, oy, oz, p):
 CASES = (("modified-phong", {"rho_d": 0.2, "rho_s": 0.5, "n": 20.0}, former_modified_phong),
          ("modified-blinn-phong", {"rho_d": 0.2, "rho_s": 0.5, "n": 20.0},
           former_modified_blinn_phong),
-         ("nielsen", {}, former_nielsen_no_eta))
+         ("nielsen", {}, former_nielsen_no_eta),
+         # the lobe series: the kernel of the class (a loop over the lobes; still the
+         # kernel of the albedo and sphere loops) against the formula unrolled per count
+         ("lafortune", {}, brdfkit.models.MODELS["lafortune"].kernel),
+         ("lafortune", {"C_xy": [-1.0, -0.9], "C_z": [1.0, 0.7], "n": [20.0, 5.0]},
+          brdfkit.models.MODELS["lafortune"].kernel),
+         ("nh-power-series", {}, brdfkit.models.MODELS["nh-power-series"].kernel))
 
 
 def hemisphere(rng, n: int) -> np.ndarray:
@@ -106,7 +113,9 @@ def main(argv=None) -> int:
         t_old = median_time(lambda old=old, out=out, m=m: old(wi, wo, m.packed, out),
                             args.repeats)
         t_new = median_time(lambda m=m: m.eval(wi, wo), args.repeats)
-        print(f"| {name:20s} | {args.pairs / t_old / 1e6:16.1f} | "
+        label = name if "n" not in params or np.ndim(params["n"]) == 0 else \
+            f"{name} {len(params['n'])} lobes"
+        print(f"| {label:20s} | {args.pairs / t_old / 1e6:16.1f} | "
               f"{args.pairs / t_new / 1e6:17.1f} | {t_old / t_new:13.2f}x |")
     print("\nload average (1, 5, 15 min): {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     return 0
