@@ -165,8 +165,12 @@ def _integrate_chunk(evaluate, th, ph, mode, width, level, sym, kinks, kvs, azs,
     """One level for the angles ``th`` at azimuths ``ph`` (results written to a[idx], e[idx];
     bad[idx] counts non-finite integrand values); returns the mask of angles whose error
     estimate is still above the goal."""
-    th = np.ascontiguousarray(th)
+    th, kvs, azs = (np.ascontiguousarray(x) for x in (th, kvs, azs))
     lv = np.full(th.size, level, dtype=np.int64)
+    # the slots from the very arrays the generator reads (the level loop's counts, from
+    # per-angle scalars, differed by an interval in rare cases: written past the slots)
+    counts = [_count_nodes(mode, th[j], width, level, sym, _X, kinks, kvs[j], azs[j])[0]
+              for j in range(th.size)]
     offsets = np.zeros(th.size + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
     total = int(offsets[-1])
@@ -177,7 +181,7 @@ def _integrate_chunk(evaluate, th, ph, mode, width, level, sym, kinks, kvs, azs,
     big = total >= PARALLEL_NODES
     gen = _gen_all_parallel if big else _gen_all_serial
     gen(mode, th, width, lv, sym, _X, _WK, _WGAUSS, offsets, wo, wk, wg, piece, kinks,
-        np.ascontiguousarray(kvs), np.ascontiguousarray(azs))
+        kvs, azs)
     vals, nbad = evaluate(th, np.ascontiguousarray(ph), offsets, wo)
     vals = np.ascontiguousarray(vals, dtype=np.float64)
     del wo
