@@ -210,3 +210,27 @@ def test_rough_beyond_the_series_says_why():
     assert not b.traced and "\n" not in b.route_reason
     del b
     gc.collect()
+
+
+def test_shared_erfc_equals_the_separate_k_and_shadow():
+    """K and S of a direction from one erfc (htsg_k_shadow_formula, the kernel's and the
+    traced route's) equal the separate formulas, each with its own erfc of the same
+    argument, bit for bit at cosines ≥ 1e-300 (TINY_COS); and σ from them is the Lambert-W
+    root of SciPy (reference above). Fails before the shared formula existed."""
+    from brdfkit.models.he_torrance import (
+        htsg_k_formula,
+        htsg_k_shadow_formula,
+        htsg_shadow_formula,
+        htsg_sigma_of_coef_formula,
+    )
+
+    for s0 in (1e-3, 0.1, 0.3, 10.0):
+        for tau in (0.01, 1.7, 1000.0):
+            for c in (1e-300, 1e-12, 1e-5, 0.01, 0.3, 0.9, 1.0):
+                k, s = htsg_k_shadow_formula(c, s0, tau)
+                assert k == htsg_k_formula(c, s0, tau), (s0, tau, c)
+                assert s == htsg_shadow_formula(c, s0, tau), (s0, tau, c)
+                k2, _ = htsg_k_shadow_formula(0.5, s0, tau)
+                want, tol = _sigma_lambert(c, 0.5, s0, tau)
+                got = htsg_sigma_of_coef_formula(0.25 * (k + k2), s0)
+                assert got == pytest.approx(want, rel=tol), (s0, tau, c)

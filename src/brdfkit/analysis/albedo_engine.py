@@ -22,7 +22,9 @@ For each t the azimuths with ω_o above the horizon form one interval
 −cot t cot θ_i; half: cos φ_max = −cos θ_i cos 2t/(sin θ_i sin 2t)), so the
 horizon cut never falls inside a quadrature panel. In half-vector space the
 azimuths where the V-groove G = min(1, 2(N·H)(N·V)/(V·H), 2(N·H)(N·L)/(L·H))
-switches branch are also break points (closed forms in :func:`_phi_breaks`).
+switches branch are also break points (closed forms in :func:`_phi_breaks`); so are the
+crests of a lobe elongated along the tangent axes (:meth:`BRDF.albedo_half_axes`) ± 3 crest
+widths, and in t where a crest meets the horizon (:func:`_axis_breaks`, :func:`_t_breaks`).
 The t axis is split at the horizon-tangency angles and graded geometrically
 at w, 2w, 4w, 8w, then 32w, 128w … for lobe width w. Every panel uses a smoothstep change of
 variable (which removes √-type endpoint singularities such as Ward's
@@ -158,13 +160,17 @@ STATUS_MESSAGES = {
 }
 
 
-def _integrate_chunk(evaluate, th, ph, mode, width, level, sym, kinks, kvs, counts, npieces, a,
-                     e, bad, idx, tol) -> np.ndarray:
+def _integrate_chunk(evaluate, th, ph, mode, width, level, sym, kinks, kvs, azs, counts,
+                     npieces, a, e, bad, idx, tol) -> np.ndarray:
     """One level for the angles ``th`` at azimuths ``ph`` (results written to a[idx], e[idx];
     bad[idx] counts non-finite integrand values); returns the mask of angles whose error
     estimate is still above the goal."""
-    th = np.ascontiguousarray(th)
+    th, kvs, azs = (np.ascontiguousarray(x) for x in (th, kvs, azs))
     lv = np.full(th.size, level, dtype=np.int64)
+    # the slots from the very arrays the generator reads (the level loop's counts, from
+    # per-angle scalars, differed by an interval in rare cases: written past the slots)
+    counts = [_count_nodes(mode, th[j], width, level, sym, _X, kinks, kvs[j], azs[j])[0]
+              for j in range(th.size)]
     offsets = np.zeros(th.size + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
     total = int(offsets[-1])
@@ -175,7 +181,7 @@ def _integrate_chunk(evaluate, th, ph, mode, width, level, sym, kinks, kvs, coun
     big = total >= PARALLEL_NODES
     gen = _gen_all_parallel if big else _gen_all_serial
     gen(mode, th, width, lv, sym, _X, _WK, _WGAUSS, offsets, wo, wk, wg, piece, kinks,
-        np.ascontiguousarray(kvs))
+        kvs, azs)
     vals, nbad = evaluate(th, np.ascontiguousarray(ph), offsets, wo)
     vals = np.ascontiguousarray(vals, dtype=np.float64)
     del wo
@@ -191,16 +197,20 @@ def _integrate_chunk(evaluate, th, ph, mode, width, level, sym, kinks, kvs, coun
 
 def _integrate(evaluate, thetas: np.ndarray, phis: np.ndarray, mode: int, width: float,
                sym: bool, tol: float, n_channels: int, kinks: int = 0,
-               levels_nv: np.ndarray | None = None
+               levels_nv: np.ndarray | None = None, axes=None
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Level loop shared by the compiled and the callable paths.
 
     ``evaluate(thetas, phis, offsets, wo) -> (vals (N, C), n_bad (T,))`` evaluates f at the
     nodes (generated for azimuth 0, rotated by each angle's φ) and counts the non-finite
     values per angle. Returns (albedo, error, status); an angle with non-finite values has
-    albedo NaN, error inf, status NONFINITE.
+    albedo NaN, error inf, status NONFINITE. ``axes``: the model's
+    :meth:`~brdfkit.models.BRDF.albedo_half_axes` (or None).
     """
     n = thetas.size
+    # per angle (φ_i, a_x, a_y, q) for quadrature._axis_breaks; a_x = NaN: no elongated lobe
+    azs = np.column_stack([phis, np.broadcast_to(np.asarray(
+        axes if axes is not None else (np.nan, np.nan, 0.0), dtype=np.float64), (n, 3))])
     kvs = (np.full((n, 0), np.nan) if levels_nv is None
            else np.asarray(levels_nv, dtype=np.float64))
     a = np.zeros((n, n_channels))
@@ -213,7 +223,7 @@ def _integrate(evaluate, thetas: np.ndarray, phis: np.ndarray, mode: int, width:
         npieces = np.empty(todo.size, dtype=np.int64)
         for k, t in enumerate(thetas[todo]):
             counts[k], npieces[k] = _count_nodes(mode, float(t), width, level, sym, _X, kinks,
-                                                 kvs[todo[k]])
+                                                 kvs[todo[k]], azs[todo[k]])
         if level > 0:
             # memory bound: an angle whose next level needs more than MAX_ANGLE_NODES keeps
             # the previous level's estimate and its (larger, honest) error estimate
@@ -233,8 +243,8 @@ def _integrate(evaluate, thetas: np.ndarray, phis: np.ndarray, mode: int, width:
                 stop += 1
             idx = todo[start:stop]
             above = _integrate_chunk(evaluate, thetas[idx], phis[idx], mode, width, level, sym,
-                                     kinks, kvs[idx], counts[start:stop], npieces[start:stop],
-                                     a, e, bad, idx, tol)
+                                     kinks, kvs[idx], azs[idx], counts[start:stop],
+                                     npieces[start:stop], a, e, bad, idx, tol)
             still.append(idx[above])
             start = stop
         todo = np.concatenate(still) if still else todo[:0]
@@ -482,8 +492,8 @@ def albedo(model, theta_i, *, phi=0.0, tol: float = 1e-7, mode: str | None = Non
     (``"nv=nl"``, ``"vgroove"``: closed-form curves made panel edges),
     ``albedo_kinks_nv(theta)`` (up to 12 levels k of circles N·V = k per angle,
     e.g. where a pumped model's g switches branch; edges in every frame, closed
-    forms in :func:`_phi_breaks`), ``specular_albedo``. At most 6e6 nodes are
-    used per angle (``MAX_ANGLE_NODES``).
+    forms in :func:`_phi_breaks`), ``albedo_half_axes``, ``specular_albedo``. At
+    most 6e6 nodes are used per angle (``MAX_ANGLE_NODES``).
 
     Examples
     --------
@@ -537,7 +547,8 @@ def albedo(model, theta_i, *, phi=0.0, tol: float = 1e-7, mode: str | None = Non
         # invariance (φ_i = 0 stands for every φ_i) and evenness in φ_i − φ_o
         sym = bool(model.isotropic and model.mirror_symmetric)
         a, e, status = _integrate(evaluate, flat, phis, m_mode, m_width, sym, tol,
-                                  n_channels, _kink_flags(model), _declared_levels(model, flat))
+                                  n_channels, _kink_flags(model), _declared_levels(model, flat),
+                                  model.albedo_half_axes())
         coloured = model.n_channels is not None
         extra = model.specular_albedo(flat)
         if extra is not None:

@@ -32,6 +32,12 @@ _KINK_BITS = {"nv=nl": KINK_NVNL, "vgroove": KINK_VGROOVE}
 _MODE = {"diffuse": NORMAL, "normal": NORMAL, "mirror": MIRROR, "half": HALF}
 MAX_LEVEL = 5
 GRADE = 2.0  # geometric grading of the t panels: w, 2w, 4w, 8w, then x4
+#: An elongated half-vector lobe (:func:`_axis_breaks`): azimuth break points at each crest
+#: ψ₀ and at ψ₀ ± 3w (e^{−9} ≈ 1e-4 of the crest for e^{−x}: the crest in two panels, its
+#: tails in the next ones; ±w, ±2w, ±4w were tried: 1.6x the nodes, the same level-0
+#: convergence). AXIS_BREAKS: the most azimuth break points this adds per half (2 crests).
+AXIS_GRADES = (3.0,)
+AXIS_BREAKS = 2 * (1 + 2 * len(AXIS_GRADES))
 
 # 15-point Kronrod nodes (abscissae on [-1, 1], positive half) and weights, with the
 # weights of the embedded 7-point Gauss rule (QUADPACK dqk15).
@@ -86,7 +92,7 @@ def _k2_cos(t, s, c):
 
 
 @numba.njit(cache=True)
-def _t_breaks(mode, theta, width, out, kv, kinks):
+def _t_breaks(mode, theta, width, out, kv, kinks, az):
     """Sorted break points of the t axis (including 0 and t_max); returns their count."""
     tmax = _t_max(mode, theta)
     e = 0.5 * math.pi - theta  # elevation of ω_i (and of R) above the horizon
@@ -153,6 +159,18 @@ def _t_breaks(mode, theta, width, out, kv, kinks):
             cand[n + 1] = sc * abs(theta - to)
             cand[n + 2] = sc * (to - theta)
             n += 3
+    if mode == HALF and az[1] > 0.0 and az[2] > 0.0 and az[1] != az[2]:
+        # an elongated lobe (_axis_breaks): where a crest (azimuth u₀ in a half, fixed in t)
+        # meets the horizon azimuth φ_max(t), cot 2t = −tan θ cos u₀, the strip's integral
+        # drops steeply (the crest leaves the visible range): a break of t
+        psi0 = 0.5 * math.pi if az[2] > az[1] else 0.0
+        for crest in range(2):
+            for sign in (1.0, -1.0):
+                u0 = sign * (psi0 + crest * math.pi - az[0])
+                u0 = u0 - 2.0 * math.pi * math.floor((u0 + math.pi) / (2.0 * math.pi))
+                if 0.0 < u0 < math.pi and n < 60:
+                    cand[n] = 0.5 * math.atan2(1.0, -math.tan(theta) * math.cos(u0))
+                    n += 1
     w = max(min(width, 0.5 * math.pi), 1e-9)
     b = w
     while b < tmax and n < 62:
@@ -178,7 +196,42 @@ def _t_breaks(mode, theta, width, out, kv, kinks):
 
 
 @numba.njit(cache=True)
-def _phi_breaks(mode, t, s, c, level, out, kinks, kv):
+def _axis_breaks(t, sign, az, out, k, phimax):
+    """Append to out[k:] the azimuth break points (node frame, this half: φ = sign·u, u in
+    (0, φ_max)) that grade an elongated half-vector lobe about its crests; returns the new k.
+
+    ``az`` = (φ_i, a_x, a_y, q): the model's lobe D(h) ∝ d(tan²t E(ψ)), E(ψ) = cos²ψ/a_x²
+    + sin²ψ/a_y² (ψ the azimuth of h in the tangent frame, ψ = φ + φ_i in the node frame;
+    :meth:`~brdfkit.models.BRDF.albedo_half_axes`) with d = e^{−x} (q = 0: Beckmann-like)
+    or (1 + x)^{−2} (q = 1: GGX-like). At fixed t it is largest on the long axis ψ₀ (E's
+    minimum 1/a_max²) and falls off in δ = ψ − ψ₀ like d(tan²t (1/a_max² + δ² Δ)),
+    Δ = |1/a_x² − 1/a_y²|: a crest of width w = √((cot²t + q/a_max²)/Δ) (the δ where the
+    argument of d grows by 1, or for q = 1 by 1 plus its crest value). a_x = NaN: none.
+    """
+    ax = az[1]
+    ay = az[2]
+    if not (ax > 0.0 and ay > 0.0) or ax == ay or t <= 0.0:
+        return k
+    tt = math.tan(t)
+    amax = max(ax, ay)
+    delta = abs(1.0 / (ax * ax) - 1.0 / (ay * ay))
+    w = math.sqrt((1.0 / (tt * tt) + az[3] / (amax * amax)) / delta)
+    psi0 = 0.5 * math.pi if ay > ax else 0.0  # the long axis
+    for crest in range(2):
+        # the crest's azimuth in this half's u = sign·φ, wrapped into (−π, π]
+        u0 = sign * (psi0 + crest * math.pi - az[0])
+        u0 = u0 - 2.0 * math.pi * math.floor((u0 + math.pi) / (2.0 * math.pi))
+        for j in range(-len(AXIS_GRADES), len(AXIS_GRADES) + 1):
+            g = 0.0 if j == 0 else (AXIS_GRADES[abs(j) - 1] if j > 0 else -AXIS_GRADES[-j - 1])
+            ph = u0 + g * w
+            if 1e-12 < ph < phimax - 1e-12 and k < out.shape[0] - 1:
+                out[k] = ph
+                k += 1
+    return k
+
+
+@numba.njit(cache=True)
+def _phi_breaks(mode, t, s, c, level, out, kinks, kv, sign, az):
     """Break points 0 = b₀ < … < b_k = φ_max of the azimuth at polar angle t; returns k + 1.
 
     φ_max is where ω_o meets the horizon (closed form). In half-vector mode,
@@ -190,6 +243,8 @@ def _phi_breaks(mode, t, s, c, level, out, kinks, kv):
     :func:`albedo`) are added in the mirror and half frames:
     mirror: N·V = c cos t + s sin t cos φ, so cos φ = (k − c cos t)/(s sin t);
     half: N·V = 2(ω_i·h) cos t − c, so ω_i·h = (k + c)/(2 cos t).
+    In half-vector mode the crests of an elongated lobe (``az``, :func:`_axis_breaks`)
+    of the half ``sign`` (+1: φ ≥ 0; −1: φ ≤ 0, returned as −φ) are graded.
     """
     st = math.sin(t)
     ct = math.cos(t)
@@ -264,6 +319,8 @@ def _phi_breaks(mode, t, s, c, level, out, kinks, kv):
                 if 1e-12 < ph < phimax - 1e-12:
                     out[k] = ph
                     k += 1
+    if mode == HALF and phimax > 0.0:
+        k = _axis_breaks(t, sign, az, out, k, phimax)
     # insertion sort of out[1:k]
     for i in range(2, k):
         v = out[i]
@@ -308,13 +365,22 @@ def _direction(mode, st, ct, phi, s, c):
 
 
 @numba.njit(cache=True)
-def _count_nodes(mode, theta, width, level, sym, X, kinks, kv):
+def _t_node(a, b, x):
+    """The polar angle of a node, a + (b − a)x: one strict (non-fastmath) function for
+    :func:`_count_nodes` and :func:`_gen_nodes`, whose azimuth break points at that t
+    must agree to the last bit (a fused multiply-add in one of them moved a break across a
+    1e-12 threshold: one interval more written than counted)."""
+    return a + (b - a) * x
+
+
+@numba.njit(cache=True)
+def _count_nodes(mode, theta, width, level, sym, X, kinks, kv, az):
     """Exact number of nodes :func:`_gen_nodes` writes, and the number of error pieces."""
     tb = np.empty(64)
-    pb = np.empty(16 + kv.shape[0])
-    nt = _t_breaks(mode, theta, width, tb, kv, kinks)
+    pb = np.empty(16 + kv.shape[0] + AXIS_BREAKS)
+    nt = _t_breaks(mode, theta, width, tb, kv, kinks, az)
     sub = 1 << level
-    n_int = (5 if mode == HALF else 2) + kv.shape[0]
+    n_int = (5 if mode == HALF else 2) + kv.shape[0] + (AXIS_BREAKS if az[1] > 0.0 else 0)
     halves = 1 if sym else 2
     s = math.sin(theta)
     c = math.cos(theta)
@@ -324,13 +390,15 @@ def _count_nodes(mode, theta, width, level, sym, X, kinks, kv):
             a = tb[ip] + (tb[ip + 1] - tb[ip]) * q / sub
             b = tb[ip] + (tb[ip + 1] - tb[ip]) * (q + 1) / sub
             for it in range(15):
-                k = _phi_breaks(mode, a + (b - a) * X[it], s, c, level, pb, kinks, kv)
-                n += min(k - 1, n_int) * sub * 15 * halves
+                for h in range(halves):
+                    k = _phi_breaks(mode, _t_node(a, b, X[it]), s, c, level, pb, kinks, kv,
+                                    1.0 - 2.0 * h, az)
+                    n += min(k - 1, n_int) * sub * 15
     return n, (nt - 1) * sub * halves
 
 
 @numba.njit(cache=True, error_model="numpy", fastmath={"nsz", "arcp", "contract"})
-def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, kinks, kv):
+def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, kinks, kv, az):
     """Fill the nodes of one incidence angle; returns the number written.
 
     wo (N, 3), wk / wg (N,) Kronrod / Gauss weights including the measure and
@@ -339,12 +407,12 @@ def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, kin
     s = math.sin(theta)
     c = math.cos(theta)
     tb = np.empty(64)
-    nt = _t_breaks(mode, theta, width, tb, kv, kinks)
+    nt = _t_breaks(mode, theta, width, tb, kv, kinks, az)
     sub = 1 << level
-    n_int = (5 if mode == HALF else 2) + kv.shape[0]
+    n_int = (5 if mode == HALF else 2) + kv.shape[0] + (AXIS_BREAKS if az[1] > 0.0 else 0)
     halves = 1 if sym else 2
     fac = 2.0 if sym else 1.0
-    pb = np.empty(16 + kv.shape[0])
+    pb = np.empty(16 + kv.shape[0] + AXIS_BREAKS)
     n = 0
     tp = 0
     for ip in range(nt - 1):
@@ -352,14 +420,14 @@ def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, kin
             a = tb[ip] + (tb[ip + 1] - tb[ip]) * q / sub
             b = tb[ip] + (tb[ip + 1] - tb[ip]) * (q + 1) / sub
             for it in range(15):
-                t = a + (b - a) * X[it]
+                t = _t_node(a, b, X[it])
                 wtk = WK[it] * (b - a)
                 wtg = WG[it] * (b - a)
-                k = _phi_breaks(mode, t, s, c, level, pb, kinks, kv)
                 st = math.sin(t)
                 ct = math.cos(t)
                 for h in range(halves):
                     sign = 1.0 if h == 0 else -1.0
+                    k = _phi_breaks(mode, t, s, c, level, pb, kinks, kv, sign, az)
                     for j in range(n_int):
                         if j >= k - 1:
                             break  # no more azimuth intervals at this t: write no nodes
@@ -371,6 +439,10 @@ def _gen_nodes(mode, theta, width, level, sym, X, WK, WG, wo, wk, wg, piece, kin
                             # one error piece per t sub-panel and half: the azimuth break
                             # points move with t, so only the strip's total is smooth in t
                             pid = tp * halves + h
+                            if n + 15 > wo.shape[0]:
+                                # never past the counted slots (a break point that differs
+                                # from _count_nodes' by rounding bounds a ~zero-width interval)
+                                continue
                             for iph in range(15):
                                 phi = sign * (fa + (fb - fa) * X[iph])
                                 ox, oy, oz, jac = _direction(mode, st, ct, phi, s, c)
@@ -420,13 +492,13 @@ def _reduce(vals, wk, wg, piece, n_pieces, n, C, out_a, out_e):
 
 
 def _gen_all_py(mode, thetas, width, levels, sym, X, WK, WG, offsets, wo, wk, wg, piece,
-                kinks, kvs):
+                kinks, kvs, azs):
     """Nodes of every angle i at its level, written at offsets[i] (parallel over angles)."""
     for i in numba.prange(thetas.shape[0]):
         o = offsets[i]
         m = offsets[i + 1] - o
         n = _gen_nodes(mode, thetas[i], width, levels[i], sym, X, WK, WG, wo[o:o + m],
-                       wk[o:o + m], wg[o:o + m], piece[o:o + m], kinks, kvs[i])
+                       wk[o:o + m], wg[o:o + m], piece[o:o + m], kinks, kvs[i], azs[i])
         for j in range(n, m):  # unused slots (absent azimuth intervals): weight 0
             wo[o + j, 0] = 0.0
             wo[o + j, 1] = 0.0

@@ -356,6 +356,12 @@ class BRDF:
         """
         return None
 
+    def albedo_half_axes(self) -> tuple[float, float, float] | None:
+        """(a_x, a_y, q) of a half-vector lobe d(tan²θ_h (cos²ψ/a_x² + sin²ψ/a_y²)), d = e^{−x}
+        (q = 0) or (1 + x)^{−2} (q = 1): where the albedo engine grades the azimuth
+        (:func:`brdfkit.analysis.quadrature._axis_breaks`; panel edges only). Default: None."""
+        return None
+
     def specular_albedo(self, theta_i) -> np.ndarray | None:
         """Albedo of the specular delta term not in :attr:`kernel` at θ_i (radians).
 

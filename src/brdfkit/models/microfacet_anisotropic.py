@@ -309,6 +309,13 @@ class MicrofacetAnisotropic(StrategySampled, BRDF):
         # the narrower axis sets the resolution; a half-vector lobe (D of h)
         return [Lobe("half", float(min(self._values["alpha_x"], self._values["alpha_y"])))]
 
+    def albedo_half_axes(self):
+        """(α_x, α_y, q): D is d(tan²θ_h (cos²ψ/α_x² + sin²ψ/α_y²)) (Heitz 2014 §5.3), d
+        Beckmann's e^{−x} (q = 0) or GGX's (1 + x)^{−2} (q = 1)."""
+        v = self._values
+        return (float(v["alpha_x"]), float(v["alpha_y"]),
+                1.0 if v["distribution"] == "ggx" else 0.0)
+
     def fresnel_split(self):
         """F = ρ_s · F_conductor(η, κ) (1 without η); white: η not given, κ = 0, ρ_s = 1 (as
         :meth:`~brdfkit.models.microfacet.Microfacet.fresnel_split`)."""
