@@ -318,16 +318,27 @@ LOOPS = {
 }
 
 
+#: Loops (branching) calling ``kernel`` via ``_kernel_call``, not inlined in Numba's IR at each
+#: site (which redoes its own inlining each time: the checked loop's two prange sites cost 170 s
+#: of a pumped nielsen's 265 s cold test). Same values (error model, no fastmath).
+CALLED_KERNEL_LOOPS = frozenset({"checked", "plain", "albedo"})
+KERNEL_CALL = ("def _kernel_call(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover\n"
+               "    return kernel(ix, iy, iz, ox, oy, oz, p)\n")
+
+
 @memo(maxsize=32)  # one entry per (loop, flags): 5 loops × a few flag sets
 def _loop_source(loop: str, *, cache: bool, generic: bool = False,
                  parallel: bool = True) -> str:
     """The functions of loop *loop* as source, decorated (``cache=True`` when *cache*), with
     the loop's constants first. *generic*: the kernel stays the first argument (one
-    compiled loop for any kernel, keyed per kernel by Numba); *parallel* False: serial."""
+    compiled loop for any kernel, keyed per kernel by Numba), else :data:`CALLED_KERNEL_LOOPS`
+    call it through ``_kernel_call``; *parallel* False: serial."""
     if loop not in LOOPS:
         raise ValueError(f"loop must be one of {', '.join(LOOPS)}; got {loop!r}")
     functions, constants = LOOPS[loop]
     parts = ["".join(f"{k} = {v!r}\n" for k, v in constants.items())]
+    if called := not generic and loop in CALLED_KERNEL_LOOPS:
+        parts.append(f'@numba.njit(error_model="numpy"{", cache=True" * cache})\n{KERNEL_CALL}')
     for name, template, options in functions:
         py = getattr(template, "py_func", template)
         fn = ast.parse(textwrap.dedent(inspect.getsource(py))).body[0]
@@ -335,6 +346,9 @@ def _loop_source(loop: str, *, cache: bool, generic: bool = False,
         fn.decorator_list = []
         if fn.args.args[0].arg == "kernel" and not generic:  # the kernel becomes a global
             fn.args.args = fn.args.args[1:]
+        for node in ast.walk(fn) if called else ():  # every kernel call through _kernel_call
+            if isinstance(node, ast.Name) and node.id == "kernel":
+                node.id = "_kernel_call"
         body = fn.body
         if (isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant)
                 and isinstance(body[0].value.value, str)):
