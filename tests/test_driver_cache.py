@@ -7,6 +7,7 @@ loads the loop from disk: a cache hit and no compilation).
 
 from __future__ import annotations
 
+import ast
 import json
 import os
 import subprocess
@@ -19,7 +20,7 @@ import pytest
 
 import brdfkit
 from brdfkit.models._base import eval_pairs_checked
-from brdfkit.models._drivers import cache_dir, cached_driver
+from brdfkit.models._drivers import CALLED_KERNEL_LOOPS, _loop_source, cache_dir, cached_driver
 
 
 def _pairs(n, seed=0):
@@ -125,3 +126,38 @@ def test_the_exact_sphere_loop_is_kept_on_disk():
     expected = 0.5 / np.pi * np.maximum(np.sin(0.5) * x + np.cos(0.5) * z, 0.0)
     inside = x * x + y * y < 1.0
     assert np.allclose(r.radiance[..., 0][inside], expected[inside], rtol=1e-12, atol=0)
+
+
+def _called_names(fn: ast.FunctionDef) -> set[str]:
+    return {n.func.id for n in ast.walk(fn) if isinstance(n, ast.Call)
+            and isinstance(n.func, ast.Name)}
+
+
+@pytest.mark.parametrize("loop", sorted(CALLED_KERNEL_LOOPS))
+def test_branching_loops_call_the_kernel_through_one_function(loop):
+    """The generated source of a branching loop (what Numba compiles): its driver calls
+    ``_kernel_call`` and never ``kernel`` itself (Numba would inline the kernel's IR at
+    each call site: the compile time this avoids, see CALLED_KERNEL_LOOPS), and
+    ``_kernel_call`` is an ordinary njit function (no ``inline=``) calling ``kernel`` once
+    with the loops' IEEE error model. The values are the generic loop's, bit for bit:
+    test_cached_loop_equals_the_generic_loop."""
+    for cache in (True, False):
+        tree = ast.parse(_loop_source(loop, cache=cache))
+        fns = {f.name: f for f in tree.body if isinstance(f, ast.FunctionDef)}
+        called = _called_names(fns["driver"])
+        assert "_kernel_call" in called and "kernel" not in called
+        wrapper = fns["_kernel_call"]
+        assert [n.func.id for n in ast.walk(wrapper) if isinstance(n, ast.Call)
+                and isinstance(n.func, ast.Name)] == ["kernel"]
+        (decorator,) = wrapper.decorator_list
+        options = {k.arg: ast.literal_eval(k.value) for k in decorator.keywords}
+        assert options == {"error_model": "numpy", **({"cache": True} if cache else {})}
+
+
+def test_the_vector_loop_inlines_the_kernel_into_its_chunk():
+    """The vectorising loop is unchanged: its chunk calls ``kernel`` directly (inlined in
+    Numba's IR once, so that LLVM vectorises the chunk's loop), with no _kernel_call."""
+    tree = ast.parse(_loop_source("vector", cache=True))
+    fns = {f.name: f for f in tree.body if isinstance(f, ast.FunctionDef)}
+    assert "_kernel_call" not in fns
+    assert "kernel" in _called_names(fns["chunk"])

@@ -12,14 +12,13 @@ that Numba caches on disk (below).
   an argument. Its statements are the ``"checked"`` and ``"plain"`` loops.
 - :func:`eval_pairs` — the same without the test, for code that has packed,
   checked arrays (:func:`generic_loop` ``("plain")``).
-- :data:`LOOPS` — the loops the generator writes, each from one hand-written
-  template: ``"checked"`` and ``"plain"`` (one pair per iteration, parallel over
-  pairs), ``"vector"`` (chunks of pairs whose inner loop LLVM vectorises, for
-  branch-free total kernels such as the microfacet models'), ``"rgb"`` (the same, for a
-  kernel computing three channels at once from all packed rows), ``"blocked"``
-  (locate a block of pairs, then read them: table lookups), ``"albedo"`` (the
-  albedo engine's serial loop over incident angles and outgoing nodes); a higher layer
-  adds its own with :func:`add_loop` (the exact sphere's, :mod:`brdfkit.render.sphere`).
+- :data:`LOOPS` — the loops the generator writes, each from one hand-written template:
+  ``"checked"`` and ``"plain"`` (one pair per iteration, parallel over pairs),
+  ``"vector"`` (chunks of pairs whose inner loop LLVM vectorises, for branch-free total
+  kernels), ``"rgb"`` (the same, three channels at once from all packed rows),
+  ``"blocked"`` (locate a block of pairs, then read them: table lookups), ``"albedo"``
+  (the albedo engine's loop over angles and nodes); :func:`add_loop` adds a higher
+  layer's (the exact sphere's, :mod:`brdfkit.render.sphere`).
 - :func:`loop_driver` — the loop *loop* for one kernel with an importable name,
   generated as a module and cached on disk (else compiled in memory);
   :func:`blocked_driver` — the blocked loop with its hooks, likewise.
@@ -28,10 +27,8 @@ that Numba caches on disk (below).
   generated as one cached module.
 - :func:`generic_loop` — a loop with the kernel as its first argument (compiled
   per kernel in each process: for code that loops over many kernels once).
-- :func:`cached_driver` — the disk-cached checked loop or None;
-  :func:`checked_driver` — :func:`loop_driver` under its former name.
-- :func:`numba_threads` — re-exported from :mod:`brdfkit._threads`, the one place that
-  sets Numba's thread count (:meth:`BRDF.eval`'s serial small calls, the fitter).
+- :func:`cached_driver` — the disk-cached checked loop or None; :func:`checked_driver`.
+- :func:`numba_threads` — re-exported from :mod:`brdfkit._threads` (Numba's threads).
 - :func:`cache_dir` — where the generated loops are kept.
 
 Loops kept on disk
@@ -40,28 +37,23 @@ Loops kept on disk
 Numba cannot cache such a specialisation on disk (it is keyed on the kernel's
 dispatcher, a new object in every process), and a closure (a vectorised or
 pumped driver built at run time) has no file to cache into: every process paid
-~1-3 s per model to compile its loop again (the README's microfacet line took
-3.2 s warm on an idle machine, 15-17 s on a loaded one).
+~1-3 s per model to compile its loop again.
 
-Here each loop is written into a tiny generated module per kernel, with the
-kernel a module global (so that LLVM inlines it), and Numba's ordinary
-``cache=True`` applies: the second process loads the compiled loop in
-milliseconds. A composite kernel is generated in the same module from its
-template (``types.FunctionType`` of the template's code object with the bound
-names as globals: the same code, so the same values as a closure over them).
+Here each loop is written into a tiny generated module per kernel, with the kernel a
+module global (so that LLVM inlines it), and Numba's ordinary ``cache=True`` applies:
+the second process loads the compiled loop in milliseconds. A composite kernel is
+generated in the same module from its template (``types.FunctionType`` of the
+template's code object with the bound names as globals: a closure's values).
 
-Staleness. Numba invalidates a cache entry when *its own* source file changes,
-not when a function it calls changes. The generated file's directory is
-therefore named after :func:`brdfkit._cache.source_stamp` (every source file of
-the brdfkit package: path, size, modification time; Numba's and Python's
-versions): any edit to brdfkit gives new files in the next process, and the old
+Staleness. Numba invalidates a cache entry when *its own* source file changes, not
+when a function it calls changes: the generated files' directory is named after
+:func:`brdfkit._cache.source_stamp` (every brdfkit source file's path, size and time;
+Numba's and Python's versions), so an edit gives new files in the next process; old
 directories are pruned after a week.
 
 Where. ``$BRDFKIT_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/brdfkit`` (default
-``~/.cache/brdfkit``), subdirectory ``drivers``. When the directory cannot be
-written, or a kernel (or a bound kernel) has no importable name (a closure, a
-lambda), the same loop is compiled in memory: nothing fails, it is only slower
-in the next process.
+``~/.cache/brdfkit``), subdirectory ``drivers``. An unwritable directory, or a kernel
+with no importable name (a closure, a lambda): the loop is compiled in memory.
 """
 
 from __future__ import annotations
@@ -320,11 +312,18 @@ LOOPS = {
 
 
 def add_loop(loop: str, functions: tuple, constants: dict | None = None) -> None:
-    """Register a loop of a higher layer (render's sphere loop) in :data:`LOOPS`, in the
-    same form, so that :func:`loop_driver` generates and caches it per kernel."""
-    if LOOPS.get(loop, (functions, constants or {})) != (functions, constants or {}):
+    """Register a higher layer's loop (render's sphere loop) in :data:`LOOPS`, in the same
+    form: :func:`loop_driver` generates and caches it per kernel. A name is taken once."""
+    if LOOPS.setdefault(loop, (functions, constants or {})) != (functions, constants or {}):
         raise ValueError(f"loop {loop!r} is registered already with other functions")
-    LOOPS[loop] = (functions, constants or {})
+
+
+#: Loops (branching) calling ``kernel`` via ``_kernel_call``, not inlined in Numba's IR at each
+#: site (which redoes its own inlining each time: the checked loop's two prange sites cost 170 s
+#: of a pumped nielsen's 265 s cold test). Same values (error model, no fastmath).
+CALLED_KERNEL_LOOPS = frozenset({"checked", "plain", "albedo"})
+KERNEL_CALL = ("def _kernel_call(ix, iy, iz, ox, oy, oz, p):  # pragma: no cover\n"
+               "    return kernel(ix, iy, iz, ox, oy, oz, p)\n")
 
 
 @memo(maxsize=32)  # one entry per (loop, flags): 5 loops × a few flag sets
@@ -332,11 +331,14 @@ def _loop_source(loop: str, *, cache: bool, generic: bool = False,
                  parallel: bool = True) -> str:
     """The functions of loop *loop* as source, decorated (``cache=True`` when *cache*), with
     the loop's constants first. *generic*: the kernel stays the first argument (one
-    compiled loop for any kernel, keyed per kernel by Numba); *parallel* False: serial."""
+    compiled loop for any kernel, keyed per kernel by Numba), else :data:`CALLED_KERNEL_LOOPS`
+    call it through ``_kernel_call``; *parallel* False: serial."""
     if loop not in LOOPS:
         raise ValueError(f"loop must be one of {', '.join(LOOPS)}; got {loop!r}")
     functions, constants = LOOPS[loop]
     parts = ["".join(f"{k} = {v!r}\n" for k, v in constants.items())]
+    if called := not generic and loop in CALLED_KERNEL_LOOPS:
+        parts.append(f'@numba.njit(error_model="numpy"{", cache=True" * cache})\n{KERNEL_CALL}')
     for name, template, options in functions:
         py = getattr(template, "py_func", template)
         fn = ast.parse(textwrap.dedent(inspect.getsource(py))).body[0]
@@ -344,6 +346,9 @@ def _loop_source(loop: str, *, cache: bool, generic: bool = False,
         fn.decorator_list = []
         if fn.args.args[0].arg == "kernel" and not generic:  # the kernel becomes a global
             fn.args.args = fn.args.args[1:]
+        for node in ast.walk(fn) if called else ():  # every kernel call through _kernel_call
+            if isinstance(node, ast.Name) and node.id == "kernel":
+                node.id = "_kernel_call"
         body = fn.body
         if (isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant)
                 and isinstance(body[0].value.value, str)):
