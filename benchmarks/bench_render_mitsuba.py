@@ -196,7 +196,7 @@ def main() -> None:
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--spp", type=int, default=16)
     ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--sections", default="rgb,measured,ported,spectral",
+    ap.add_argument("--sections", default="rgb,measured,ported,registry,spectral",
                     help="comma-separated subset of rgb, measured, ported, registry, spectral")
     ap.add_argument("--traced-only", action="store_true",
                     help="leave out the wavefront-route rows (slow; the images' agreement "
