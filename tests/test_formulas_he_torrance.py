@@ -27,9 +27,11 @@ import brdfkit
 from brdfkit.models.he_torrance import (
     SERIES_MAX_TERMS,
     _htsg_k,
+    htsg_k_shadow_formula,
     htsg_series,
+    htsg_shadow,
     htsg_sigma,
-    htsg_sigma_formula,
+    htsg_sigma_of_coef_formula,
     series_terms,
 )
 
@@ -54,6 +56,13 @@ def _sigma_lambert(cos_i, cos_r, sigma0, tau):
     return sigma0 / math.sqrt(1.0 + w), tol
 
 
+def _sigma_formula(cos_i, cos_r, sigma0, tau):
+    """σ as the kernel and the traced formula compute it: A from each direction's K."""
+    k_i, _ = htsg_k_shadow_formula(cos_i, sigma0, tau)
+    k_r, _ = htsg_k_shadow_formula(cos_r, sigma0, tau)
+    return htsg_sigma_of_coef_formula(0.25 * (k_i + k_r), sigma0)
+
+
 def test_sigma_formula_is_the_lambert_w_root():
     """The fixed four Newton steps give HTSG's root to ~1e-15 over σ₀, τ across their
     declared ranges and cosines from the horizon (1e-300) to the normal; the kernel's
@@ -65,7 +74,7 @@ def test_sigma_formula_is_the_lambert_w_root():
             for ci in (1e-300, 1e-60, 1e-12, 1e-5, 0.01, 0.3, 0.9, 1.0):
                 for cr in (1e-8, 0.2, 0.99, 1.0):
                     want, tol = _sigma_lambert(ci, cr, s0, tau)
-                    got = htsg_sigma_formula(ci, cr, s0, tau)
+                    got = _sigma_formula(ci, cr, s0, tau)
                     assert got == pytest.approx(want, rel=tol), (s0, tau, ci, cr)
                     a = 0.25 * (_htsg_k(ci, s0, tau) + _htsg_k(cr, s0, tau))
                     if a < 1e30:
@@ -214,23 +223,15 @@ def test_rough_beyond_the_series_says_why():
 
 def test_shared_erfc_equals_the_separate_k_and_shadow():
     """K and S of a direction from one erfc (htsg_k_shadow_formula, the kernel's and the
-    traced route's) equal the separate formulas, each with its own erfc of the same
-    argument, bit for bit at cosines ≥ 1e-300 (TINY_COS); and σ from them is the Lambert-W
-    root of SciPy (reference above). Fails before the shared formula existed."""
-    from brdfkit.models.he_torrance import (
-        htsg_k_formula,
-        htsg_k_shadow_formula,
-        htsg_shadow_formula,
-        htsg_sigma_of_coef_formula,
-    )
-
+    traced route's) equal the branching reference functions _htsg_k and htsg_shadow, each
+    with its own erfc of the same argument, bit for bit at cosines ≥ 1e-300 (TINY_COS); and
+    σ from them is the Lambert-W root of SciPy (reference above)."""
     for s0 in (1e-3, 0.1, 0.3, 10.0):
         for tau in (0.01, 1.7, 1000.0):
             for c in (1e-300, 1e-12, 1e-5, 0.01, 0.3, 0.9, 1.0):
                 k, s = htsg_k_shadow_formula(c, s0, tau)
-                assert k == htsg_k_formula(c, s0, tau), (s0, tau, c)
-                assert s == htsg_shadow_formula(c, s0, tau), (s0, tau, c)
-                k2, _ = htsg_k_shadow_formula(0.5, s0, tau)
+                assert k == _htsg_k(c, s0, tau), (s0, tau, c)
+                assert s == htsg_shadow(c, s0, tau), (s0, tau, c)
                 want, tol = _sigma_lambert(c, 0.5, s0, tau)
-                got = htsg_sigma_of_coef_formula(0.25 * (k + k2), s0)
-                assert got == pytest.approx(want, rel=tol), (s0, tau, c)
+                assert _sigma_formula(c, 0.5, s0, tau) == pytest.approx(want, rel=tol), \
+                    (s0, tau, c)

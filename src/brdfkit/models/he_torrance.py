@@ -18,8 +18,8 @@ fixed-length, branch-free forms of the two loops (:func:`he_torrance_formulas`):
   step on the iterates approach the root from below, staying positive) from Winitzki's
   start w₀ = ℓ(1 − ln(1 + ℓ)/(2 + ℓ)), ℓ = ln(1 + e^L), within 2 % of W everywhere;
   the relative error squares per step (factor ≤ 1/2): ≤ 1e-15 after four
-  (:func:`htsg_sigma_formula`; tests/test_formulas_he_torrance.py checks it against
-  :func:`htsg_sigma`'s safeguarded Newton);
+  (:func:`htsg_sigma_of_coef_formula`; tests/test_formulas_he_torrance.py checks it
+  against SciPy's Lambert W and :func:`htsg_sigma`'s safeguarded Newton);
 - the series of D: written as T = S/g = Σ_{m≥1} e^{−g} g^{m−1}/(m!·m) e^{−a/m} (so that
   G·S = (v·v)²(2πσ)² T needs no division by v_z and no small-g branch), summed upward
   from m = 1 over a fixed number of terms N, the smallest whose tail bound
@@ -184,29 +184,6 @@ SHADOW_GRAZING = 1e-8  # htsg_shadow's small-a limit, kept
 
 
 @formula
-def htsg_shadow_formula(cos_t, sigma0, tau):
-    """:func:`htsg_shadow` as a formula (its branches selects, the same operations)."""
-    sin_t = sqrt(maximum(0.0, 1.0 - cos_t * cos_t))  # clamp: rounding near the pole
-    pos = sin_t > 0.0
-    a = tau * cos_t / (2.0 * sigma0 * select(pos, sin_t, 1.0))  # 1.0: the normal (S = 1)
-    small = a < SHADOW_GRAZING  # grazing: S = a√π (1 + O(a))
-    b = select(small, 1.0, a)  # 1.0: the discarded lane stays finite
-    erfc_b = erfc(b)
-    lam = 0.5 * (exp(-b * b) / (b * SQRT_PI) - erfc_b)
-    s = select(small, a * SQRT_PI, (1.0 - 0.5 * erfc_b) / (lam + 1.0))
-    return select(cos_t <= 0.0, 0.0, select(pos, s, 1.0))
-
-
-@formula
-def htsg_k_formula(cos_t, sigma0, tau):
-    """:func:`_htsg_k`, K(θ) = tan θ erfc(τ cot θ/(2σ₀)), as a formula."""
-    c = maximum(cos_t, TINY_COS)  # floor: tan θ stays finite (< 1e300) at the horizon
-    s = sqrt(maximum(0.0, 1.0 - c * c))  # clamp: rounding near the pole
-    pos = s > 0.0
-    return select(pos, (s / c) * erfc(tau * c / (2.0 * sigma0 * select(pos, s, 1.0))), 0.0)
-
-
-@formula
 def _w_step(w, big_l):
     """One Newton step on w + ln w = L: w (1 + L − ln w)/(1 + w)."""
     return w * (1.0 + big_l - log(w)) / (1.0 + w)
@@ -231,18 +208,12 @@ def htsg_sigma_of_coef_formula(a_coef, sigma0):
 
 
 @formula
-def htsg_sigma_formula(cos_i, cos_r, sigma0, tau):
-    """:func:`htsg_sigma` as a formula: σ = σ₀/√(1 + u²), u² = W(B²) (module docstring)."""
-    a_coef = 0.25 * (htsg_k_formula(cos_i, sigma0, tau) + htsg_k_formula(cos_r, sigma0, tau))
-    return htsg_sigma_of_coef_formula(a_coef, sigma0)
-
-
-@formula
 def htsg_k_shadow_formula(cos_t, sigma0, tau):
-    """(K(θ), S(θ)) of one direction with ONE erfc: :func:`htsg_k_formula` and
-    :func:`htsg_shadow_formula` both read erfc(a), a = τ cot θ/(2σ₀). Equal to them for
-    cos θ ≥ 1e-300 (TINY_COS); below it K's tan θ is floored as before but its erfc reads
-    the true a (the same to O(a) ≤ 1e-8 relative, since then a < 1e-8 unless σ₀/τ < 1e-292)."""
+    """(K(θ), S(θ)) of one direction with ONE erfc, a = τ cot θ/(2σ₀): :func:`_htsg_k` and
+    :func:`htsg_shadow` as one formula (their branches selects, the same operations).
+    Equal to them for cos θ ≥ 1e-300 (TINY_COS); below it K's tan θ is floored as before
+    but its erfc reads the true a (the same to O(a) ≤ 1e-8 relative, since then a < 1e-8
+    unless σ₀/τ < 1e-292)."""
     c = maximum(cos_t, TINY_COS)  # floor: tan θ stays finite (< 1e300) at the horizon
     sin_t = sqrt(maximum(0.0, 1.0 - cos_t * cos_t))  # clamp: rounding near the pole
     pos = sin_t > 0.0
