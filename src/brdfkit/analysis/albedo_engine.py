@@ -160,8 +160,8 @@ STATUS_MESSAGES = {
 }
 
 
-def _integrate_chunk(evaluate, th, ph, mode, width, level, sym, kinks, kvs, azs, counts,
-                     npieces, a, e, bad, idx, tol) -> np.ndarray:
+def _integrate_chunk(evaluate, th, ph, mode, width, level, sym, kinks, kvs, azs, npieces, a,
+                     e, bad, idx, tol) -> np.ndarray:
     """One level for the angles ``th`` at azimuths ``ph`` (results written to a[idx], e[idx];
     bad[idx] counts non-finite integrand values); returns the mask of angles whose error
     estimate is still above the goal."""
@@ -243,8 +243,8 @@ def _integrate(evaluate, thetas: np.ndarray, phis: np.ndarray, mode: int, width:
                 stop += 1
             idx = todo[start:stop]
             above = _integrate_chunk(evaluate, thetas[idx], phis[idx], mode, width, level, sym,
-                                     kinks, kvs[idx], azs[idx], counts[start:stop],
-                                     npieces[start:stop], a, e, bad, idx, tol)
+                                     kinks, kvs[idx], azs[idx], npieces[start:stop], a, e,
+                                     bad, idx, tol)
             still.append(idx[above])
             start = stop
         todo = np.concatenate(still) if still else todo[:0]
