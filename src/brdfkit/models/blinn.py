@@ -56,7 +56,7 @@ from brdfkit.models._lobes import (
 )
 from brdfkit.models._params import packed_indices
 from brdfkit.models._registry import register
-from brdfkit.models.lobe_series import nh_series_formulas
+from brdfkit.models.lobe_series import nh_series_formulas, series_eval
 from brdfkit.models.sampling import (
     COSINE,
     Mixture,
@@ -208,7 +208,8 @@ class NHPowerSeries(CosineLobeBRDF):
         # model.eval runs the formula unrolled for this instance's number of terms in the
         # vectorising loop: bit-identical to the kernel's loop over the terms, which LLVM
         # cannot vectorise (measured: 2-3x the M evals/s of the kernel's checked loop)
-        self._driver = loop_driver(self.formulas().eval, loop="vector")
+        self._driver = loop_driver(series_eval("nh", self.channel_values(0)["n"]),
+                                   loop="vector")
 
     def formulas(self) -> Formulas:
         """f_r, the sampler of :meth:`_strategy` and its pdf as formulas unrolled for this

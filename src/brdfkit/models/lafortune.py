@@ -38,7 +38,7 @@ from brdfkit.models._base import Lobe, Param
 from brdfkit.models._drivers import loop_driver
 from brdfkit.models._lobes import RHO_D, CosineLobeBRDF, channel_mean, lobe_hint, lobe_pow
 from brdfkit.models._registry import register
-from brdfkit.models.lobe_series import lafortune_formulas
+from brdfkit.models.lobe_series import lafortune_formulas, series_eval
 from brdfkit.models.sampling import COSINE, Mixture, log_mixture_weights, phong_lobe
 
 __all__ = ["Lafortune"]
@@ -148,7 +148,8 @@ class Lafortune(CosineLobeBRDF):
         # model.eval runs the formula unrolled for this instance's number of lobes in the
         # vectorising loop: bit-identical to the kernel's loop over the lobes, which LLVM
         # cannot vectorise (measured: 1.4-2x the M evals/s of the kernel's checked loop)
-        self._driver = loop_driver(self.formulas().eval, loop="vector")
+        self._driver = loop_driver(series_eval("lafortune", self.channel_values(0)["n"]),
+                                   loop="vector")
 
     def _pack_channel(self, v):
         # ρ_d, ρ_s in their parameters' slots (the Mitsuba bridge exposes them by slot),

@@ -28,7 +28,8 @@ parameter values are arguments, not literals (a new value compiles nothing).
 
 Public objects
 --------------
-- :func:`lafortune_formulas`, :func:`nh_series_formulas` — a model's ``Formulas``.
+- :func:`lafortune_formulas`, :func:`nh_series_formulas` — a model's ``Formulas``;
+  :func:`series_eval` — its eval formula alone (what ``model.eval`` runs).
 - :func:`mixture_pick_lines` — ``Mixture.sample``'s pick as generated formula lines
   (also the Kulla–Conty sampler's, :mod:`brdfkit.compensation.kernels`).
 """
@@ -41,7 +42,7 @@ from brdfkit._cache import memo
 from brdfkit._dual import Formulas
 from brdfkit.models._lobes import lobe_mode
 
-__all__ = ["lafortune_formulas", "nh_series_formulas", "mixture_pick_lines"]
+__all__ = ["lafortune_formulas", "nh_series_formulas", "series_eval", "mixture_pick_lines"]
 
 _HEADER = '''"""brdfkit: generated {what} formulas, {m} lobes (models/lobe_series)."""
 from brdfkit._dual import exp, formula, log, maximum, minimum, power, select, sqrt
@@ -225,6 +226,12 @@ def _modes(n) -> tuple:
 
 def _log(x: float) -> float:
     return math.log(x) if x > 0.0 else -math.inf
+
+
+def series_eval(kind: str, n):
+    """The eval formula of *kind* (``"lafortune"`` or ``"nh"``) for the lobes' exponents
+    *n*: what ``model.eval`` runs, without the sampler's arguments of the full formulas."""
+    return _generated(kind, len(n), _modes(n))[0]
 
 
 def lafortune_formulas(model) -> Formulas:
